@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: MIT
+/// @file contact_collider.hpp
+/// A ready near callback that does the collision bookkeeping for the application: it collides
+/// geom pairs, lets the application fill the surface parameters, drives feeder contacts through
+/// a FeederSet and creates and attaches the contact joints itself, in ODE's attach order
+/// `dJointAttach(j, dGeomGetBody(g1), dGeomGetBody(g2))` (or the reverse when the FeederSet's
+/// Options::attach_order is G2First).
+///
+///     rheofeed::ContactCollider collider(world, feeders);
+///     collider.setSurfaceCallback([](dGeomID, dGeomID, dContact* c, int n) {
+///       for (int i = 0; i < n; ++i) { c[i].surface.mode = 0; c[i].surface.mu = 0.5; }
+///       return true;                                  // false: no joints for this pair
+///     });
+///     // each step:
+///     collider.collide(space, time);                  // beginStep + dSpaceCollide + joints
+///     dWorldQuickStep(world, h);
+///
+/// Applications that call dSpaceCollide themselves pass `&collider` and
+/// `ContactCollider::nearCallback` to it (after `beginStep(time)` and `clearJoints()`).
+#pragma once
+
+#include <ode/ode.h>
+
+#include <deque>
+#include <functional>
+#include <vector>
+
+#include "rheofeed/feeder_set.hpp"
+
+namespace rheofeed {
+
+/// Fills `contacts[0..count)` (produced by dCollide for geoms o1, o2) with the application's
+/// surface parameters (mode, mu, bounce, soft_erp, ...). Return false to reject the pair. Called
+/// from inside dSpaceCollide; it must not throw.
+using SurfaceCallback = std::function<bool(dGeomID o1, dGeomID o2, dContact* contacts, int count)>;
+
+/// Collides a space and creates the step's contact joints. Owns its contact joint group.
+class ContactCollider {
+ public:
+  struct Settings {
+    /// Contacts asked of dCollide per geom pair (ODE's `flags` low bits), 1..65535.
+    int max_contacts_per_pair = 8;
+    /// Skip pairs whose bodies are already connected by a non-contact joint.
+    bool skip_connected_bodies = true;
+    /// Attach a dJointFeedback to every feeder contact joint (forces readable after the step
+    /// through FeederSet::records(); needs FeederSet::Options::record_contacts).
+    bool feedback = false;
+    /// Surface used when no SurfaceCallback is set: Approx1 friction with mu = 0.5.
+    dSurfaceParameters default_surface = {dContactApprox1, 0.5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  };
+
+  /// `world` receives the joints; `feeders` must outlive the collider. Throws
+  /// std::invalid_argument for a null world or max_contacts_per_pair outside 1..65535.
+  ContactCollider(dWorldID world, FeederSet& feeders);
+  ContactCollider(dWorldID world, FeederSet& feeders, const Settings& settings);
+  ~ContactCollider();
+  ContactCollider(const ContactCollider&) = delete;
+  ContactCollider& operator=(const ContactCollider&) = delete;
+
+  /// The application's surface callback (optional).
+  void setSurfaceCallback(SurfaceCallback callback);
+
+  /// One step's collision at simulation time `time` (s): empties the joint group, calls
+  /// feeders.beginStep(time), collides `space` (recursing into sub-spaces) and creates joints.
+  void collide(dSpaceID space, double time);
+  /// Empties the contact joint group (collide does it).
+  void clearJoints();
+  /// A dNearCallback; `data` must be a ContactCollider*.
+  static void nearCallback(void* data, dGeomID o1, dGeomID o2);
+
+  /// Contact joints created since the last clearJoints.
+  int contactCount() const { return contact_count_; }
+  dJointGroupID jointGroup() const { return group_; }
+
+ private:
+  void handlePair(dGeomID o1, dGeomID o2);
+  void collideWithin(dSpaceID space);
+
+  dWorldID world_;
+  FeederSet& feeders_;
+  Settings settings_;
+  dJointGroupID group_;
+  SurfaceCallback surface_;
+  std::vector<dContact> buffer_;
+  std::deque<dJointFeedback> feedback_;
+  std::size_t feedback_used_ = 0;
+  int contact_count_ = 0;
+};
+
+}  // namespace rheofeed

@@ -1,0 +1,182 @@
+// SPDX-License-Identifier: MIT
+/// @file motion_law.hpp
+/// Motion laws of a feeder surface: what tangential velocity the surface imposes on a part at a
+/// contact point. One piece of code serves the ODE plugin and the reference solver.
+///
+/// ## Sign convention (read this once)
+/// A twist `v_a = [v; w]` about an origin `O` gives the surface velocity at a point `p`
+///
+///     v_p = v + w x (p - O)                                   (the ordinary rigid-body field)
+///
+/// Fusai & Tasora print eq. 4 as `v_p = v + r x w` with `r = p - O`, which is the opposite
+/// rotation sense: `r x w = -(w x r)`. We use `w x (p - O)`, as Project Chrono's implementation of
+/// the paper (ChFeeder) does, because only then does a turntable spinning with `w = +z` move parts
+/// counter-clockwise seen from above, and a part climbs a helical ramp whose handedness agrees with
+/// `w` (tests/plugin pin both down). To enter a twist written with the paper's form, negate `w`.
+///
+/// The normal part is discarded: the rheonomic term is `c_t = v_p - (v_p . n) n`, where n is the
+/// unit contact normal. Penetration recovery, restitution and any normal motion stay as the
+/// application set them.
+///
+/// All vectors are in metres, m/s and rad/s; "world" means the ODE world frame, "body" means the
+/// frame of the body that carries the feeder geom (the law then follows the body).
+#pragma once
+
+#include <functional>
+#include <limits>
+#include <string>
+
+#include "rheofeed/vec3.hpp"
+
+namespace rheofeed {
+
+/// The frame a law's vectors are given in.
+enum class Frame {
+  World,  ///< World frame; the law does not move.
+  Body,   ///< Frame of the feeder geom's body (x_world = R x_body + body position); the law
+          ///< moves and turns with the body. A geom without a body cannot use it.
+};
+
+/// The motion "eigenvalues" of a feeder: linear velocity `linear` (m/s), angular velocity
+/// `angular` (rad/s), about the point `origin` (m). Frame: that of the owning law.
+struct Twist {
+  Vec3 linear;   ///< v (unit: m/s)
+  Vec3 angular;  ///< w (unit: rad/s); the surface turns by the right-hand rule about w.
+  Vec3 origin;   ///< O (unit: m), the point whose surface velocity is `linear`.
+};
+
+/// A direct tangential field, for when the speed map is known: given the contact point `p`
+/// (m, world), the unit contact normal `n` (world) and the simulation time `t` (s), return the
+/// surface velocity (m/s, world). Any normal component of the result is discarded. It must be
+/// safe to call from the near callback, and must not throw.
+using SurfaceField = std::function<Vec3(const Vec3& p, const Vec3& n, double t)>;
+
+/// A dimensionless scale `s(t)` applied to every velocity of a law (time `t` in seconds).
+/// The default is the constant 1.
+class TimeProfile {
+ public:
+  /// s(t) = 1.
+  TimeProfile() = default;
+  /// s(t) = scale.
+  static TimeProfile constant(double scale);
+  /// s(t) = from for t <= t_start, to for t >= t_end, linear in between (s); t_end > t_start.
+  static TimeProfile ramp(double t_start, double t_end, double from, double to);
+  /// s(t) = 1 for t_on <= t < t_off, 0 otherwise (s); t_off may be +infinity.
+  static TimeProfile onOff(double t_on, double t_off = std::numeric_limits<double>::infinity());
+  /// s(t) = scale(t), a user function; it is evaluated once per step per feeder.
+  static TimeProfile function(std::function<double(double t)> scale);
+
+  /// The scale at time t (s). A user function may return a non-finite value; callers check.
+  double operator()(double t) const;
+  /// True when s(t) cannot change with t (only the constant profile).
+  bool isConstant() const { return kind_ == Kind::Constant; }
+  /// Throws std::invalid_argument naming the bad parameter (prefix names where it came from).
+  void validate(const std::string& where) const;
+
+ private:
+  enum class Kind { Constant, Ramp, OnOff, Function };
+  Kind kind_ = Kind::Constant;
+  double a_ = 1.0, b_ = 0.0, c_ = 0.0, d_ = 0.0;
+  std::function<double(double)> function_;
+};
+
+class StepLaw;
+
+/// How a feeder surface moves. A value type: build it with one of the named constructors, then
+/// optionally `withProfile`. The plugin freezes it once per step (`evaluate`) and then computes
+/// only what the law needs per contact: a pure translation does no cross product, a field skips
+/// the twist, a belt only projects its direction.
+class MotionLaw {
+ public:
+  /// What the law is made of.
+  enum class Kind {
+    Twist,          ///< constant twist v + w x (p - O)
+    TwistFunction,  ///< twist given as a user function of time
+    Belt,           ///< a belt: speed s along a direction, kept at |s| on any face it is not normal to
+    Field,          ///< a user field c(p, n, t)
+  };
+
+  /// The default law: a stationary surface (zero twist, world frame).
+  MotionLaw() = default;
+
+  /// Rigid twist about `twist.origin`, in `frame`.
+  static MotionLaw twist(const Twist& twist, Frame frame = Frame::World);
+  /// Pure translation: v_p = velocity (m/s) everywhere.
+  static MotionLaw translation(const Vec3& velocity, Frame frame = Frame::World);
+  /// Pure rotation with angular velocity `angular_velocity` (rad/s) about `origin` (m).
+  static MotionLaw rotation(const Vec3& angular_velocity, const Vec3& origin,
+                            Frame frame = Frame::World);
+  /// A belt moving at `speed` (m/s; negative reverses it) along `direction` (any length > 0).
+  /// At a contact, c_t = speed * unit(direction projected on the contact plane), so a belt laid
+  /// on an incline still runs at |speed| along its surface; where the direction is (nearly)
+  /// normal to the contact plane (the belt's end faces) c_t = 0.
+  static MotionLaw belt(const Vec3& direction, double speed, Frame frame = Frame::World);
+  /// A direct tangential field in the world frame. `time_varying` says that the field itself
+  /// depends on t (besides any profile), so sleeping parts are woken every step it is in use.
+  static MotionLaw field(SurfaceField field, bool time_varying = false);
+  /// A twist that varies with time: `twist_of_time(t)` (t in s) is called once per step.
+  static MotionLaw twistFunction(std::function<Twist(double t)> twist_of_time,
+                                 Frame frame = Frame::World);
+
+  /// A copy of this law whose velocities are multiplied by `profile(t)`.
+  MotionLaw withProfile(TimeProfile profile) const;
+
+  Kind kind() const { return kind_; }
+  Frame frame() const { return frame_; }
+  /// The constant twist (Twist kind) or the belt as {direction * speed, 0, 0} (Belt kind).
+  const Twist& constantTwist() const { return twist_; }
+  const TimeProfile& profile() const { return profile_; }
+  /// True if the law's values can change with time (a profile, a twist function, a time-varying
+  /// field). Constant laws are evaluated once and cached.
+  bool isTimeVarying() const;
+
+  /// Throws std::invalid_argument with a message naming the bad value and `where` it came from,
+  /// e.g. "feeder 0x55d0: law twist.linear.x = nan is not finite".
+  void validate(const std::string& where) const;
+
+  /// Freeze the law at time `t` (s). `body_pose` is the pose of the body carrying the feeder
+  /// (needed for Frame::Body, ignored otherwise; nullptr means the world frame).
+  StepLaw evaluate(double t, const Pose* body_pose) const;
+
+ private:
+  Kind kind_ = Kind::Twist;
+  Frame frame_ = Frame::World;
+  Twist twist_{};
+  double belt_speed_ = 0.0;
+  SurfaceField field_;
+  bool field_time_varying_ = false;
+  std::function<Twist(double)> twist_function_;
+  TimeProfile profile_;
+};
+
+/// A law frozen at one time step in the world frame: what the per-contact evaluation reads.
+class StepLaw {
+ public:
+  /// Tangential surface velocity c_t (m/s, world) at contact point `p` (m, world) with unit
+  /// normal `n`. Non-finite only if a user function returned a non-finite value (then
+  /// `isFinite` of the result is false and the caller leaves the contact undriven).
+  Vec3 tangentialVelocity(const Vec3& p, const Vec3& n) const;
+
+  /// Whether the frozen values are all finite (a profile or twist function can fail).
+  bool finite() const { return finite_; }
+  /// Short description of the first non-finite value, empty if finite.
+  const std::string& problem() const { return problem_; }
+  /// True if every contact would get c_t = 0 (zero scale or zero twist).
+  bool isZero() const { return eval_ == Eval::Zero; }
+  /// Whether two frozen laws impose the same surface velocities (for waking sleeping parts).
+  bool sameMotionAs(const StepLaw& other) const;
+
+ private:
+  friend class MotionLaw;
+  enum class Eval { Zero, Translation, Twist, Belt, Field };
+  Eval eval_ = Eval::Zero;
+  Vec3 v_, w_, o_;  // world frame; Belt: v_ = unit direction, w_.x = speed
+  const SurfaceField* field_ = nullptr;
+  double scale_ = 1.0;
+  double time_ = 0.0;
+  bool time_varying_field_ = false;
+  bool finite_ = true;
+  std::string problem_;
+};
+
+}  // namespace rheofeed

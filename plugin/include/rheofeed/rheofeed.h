@@ -1,0 +1,117 @@
+/* SPDX-License-Identifier: MIT */
+/**
+ * @file rheofeed.h
+ * C API of the rheofeed ODE plugin, in ODE's Object-Verb style with the prefix `rf`.
+ * It wraps rheofeed::FeederSet (feeder_set.hpp), which documents the physics and sign rules:
+ * each feeder contact gets fdir1 = unit(c_rel) and motion1 = |c_rel| (m/s) so that the part moves
+ * with the feeder surface, whatever the geom order or body layout, assuming the application
+ * attaches joints as dJointAttach(j, dGeomGetBody(g1), dGeomGetBody(g2)) (ODE's convention).
+ *
+ *     rfFeederSetID feeders = rfFeederSetCreate();
+ *     double dir[3] = {1, 0, 0};
+ *     rfFeederSetAddBelt(feeders, belt_geom, dir, 0.3, rfFrameWorld);
+ *     // each step: rfFeederSetBeginStep(feeders, t); then in the near callback:
+ *     n = rfFeederSetDriveContacts(feeders, contact, n);
+ *
+ * Units: metres, seconds, m/s, rad/s. Vectors are double[3] in the world frame unless the law's
+ * frame is rfFrameBody (then in the frame of the feeder geom's body).
+ *
+ * Errors: functions returning int give rfOK (0) or a negative rfError code; the message, which
+ * names the bad value, is then read with rfFeederSetGetLastError. Nothing here throws or aborts.
+ */
+#ifndef RHEOFEED_RHEOFEED_H_
+#define RHEOFEED_RHEOFEED_H_
+
+#include <ode/ode.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Opaque handle of a feeder set. */
+typedef struct rfFeederSet* rfFeederSetID;
+
+/** Result codes. */
+enum {
+  rfOK = 0,
+  rfErrorInvalidArgument = -1, /**< a value was refused; see rfFeederSetGetLastError */
+  rfErrorOutOfMemory = -2,
+  rfErrorInternal = -3
+};
+
+/** Frame of a law's vectors. */
+enum { rfFrameWorld = 0, rfFrameBody = 1 };
+
+/** Which body the application attaches first (rfFeederSetCreateWithOptions). */
+enum { rfAttachG1First = 0, rfAttachG2First = 1 };
+
+/** A direct tangential field: write into `out` the surface velocity (m/s, world) at point `p`
+ *  (m, world) with unit normal `n` at time `t` (s); the normal part is discarded. */
+typedef void rfFieldFunction(void* user, const double p[3], const double n[3], double t,
+                             double out[3]);
+
+/** A diagnostic: `kind` is one of "invalid_contact", "zero_friction", "law_not_finite",
+ *  "force_cap_friction"; `message` names the value. Valid during the call only. */
+typedef void rfDiagnosticFunction(void* user, const char* kind, dGeomID feeder,
+                                  const char* message);
+
+/** Create a feeder set with default options (dContactApprox1 forced, attach order g1 first).
+ *  Returns 0 if ODE is not double precision or memory ran out. */
+rfFeederSetID rfFeederSetCreate(void);
+/** Create with options: force_approx1 (0/1), attach_order (rfAttach*), min_surface_speed (m/s,
+ *  >= 0). Returns 0 on a bad option or failure. */
+rfFeederSetID rfFeederSetCreateWithOptions(int force_approx1, int attach_order,
+                                           double min_surface_speed);
+void rfFeederSetDestroy(rfFeederSetID set);
+
+/** Register `geom` with twist v = linear (m/s), w = angular (rad/s) about origin (m):
+ *  surface velocity v + w x (p - origin). */
+int rfFeederSetAddTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
+                        const double angular[3], const double origin[3], int frame);
+/** Register `geom` as a belt: `speed` (m/s, negative reverses) along `direction`. */
+int rfFeederSetAddBelt(rfFeederSetID set, dGeomID geom, const double direction[3], double speed,
+                       int frame);
+/** Register `geom` with a direct field (world frame); time_varying != 0 if it depends on t. */
+int rfFeederSetAddField(rfFeederSetID set, dGeomID geom, rfFieldFunction* field, void* user,
+                        int time_varying);
+
+/** Replace the law of a registered feeder (same parameters as the Add functions). Sleeping
+ *  parts on it are woken at the next collision pass. */
+int rfFeederSetSetTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
+                        const double angular[3], const double origin[3], int frame);
+int rfFeederSetSetBelt(rfFeederSetID set, dGeomID geom, const double direction[3], double speed,
+                       int frame);
+
+/** Scale the feeder's law by a linear ramp from `from` at t_start to `to` at t_end (s). */
+int rfFeederSetSetRamp(rfFeederSetID set, dGeomID geom, double t_start, double t_end,
+                       double from, double to);
+/** Switch the feeder's law on for t_on <= t < t_off (s), off otherwise. */
+int rfFeederSetSetOnOff(rfFeederSetID set, dGeomID geom, double t_on, double t_off);
+
+/** Unregister a feeder. */
+int rfFeederSetRemove(rfFeederSetID set, dGeomID geom);
+/** 1 if `geom` is a registered feeder, else 0. */
+int rfFeederSetContains(rfFeederSetID set, dGeomID geom);
+
+/** Start a step at simulation time `time` (s), before collision. */
+int rfFeederSetBeginStep(rfFeederSetID set, double time);
+/** Drive the feeder contacts of `contacts[0..count)`; returns how many contacts to create
+ *  joints for (invalid feeder contacts are removed, the rest kept in order), or a negative
+ *  rfError code. Safe to call from a near callback. */
+int rfFeederSetDriveContacts(rfFeederSetID set, dContact* contacts, int count);
+
+/** Feeder contacts given fdir1/motion1 since the last rfFeederSetBeginStep, or a negative
+ *  rfError code for an unregistered geom. */
+int rfFeederSetGetContactsDriven(rfFeederSetID set, dGeomID geom);
+
+/** Receive diagnostics (0 restores the default: first report per kind and feeder on stderr). */
+void rfFeederSetSetDiagnosticFunction(rfFeederSetID set, rfDiagnosticFunction* fn, void* user);
+
+/** The message of the latest failed call on `set` ("" if none); valid until the next call. */
+const char* rfFeederSetGetLastError(rfFeederSetID set);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RHEOFEED_RHEOFEED_H_ */

@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: MIT
+/// @file vec3.hpp
+/// A minimal 3-vector for the motion laws. It depends on nothing, so the laws serve the ODE
+/// plugin and the Eigen reference solver alike (neither library's types leak into the other).
+#pragma once
+
+#include <cmath>
+
+namespace rheofeed {
+
+/// A 3-vector of doubles. Its unit and frame are those of the value it carries; every function
+/// that takes or returns one says which.
+struct Vec3 {
+  double x = 0.0;
+  double y = 0.0;
+  double z = 0.0;
+};
+
+inline Vec3 operator+(const Vec3& a, const Vec3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Vec3 operator-(const Vec3& a, const Vec3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Vec3 operator-(const Vec3& a) { return {-a.x, -a.y, -a.z}; }
+inline Vec3 operator*(double s, const Vec3& a) { return {s * a.x, s * a.y, s * a.z}; }
+inline bool operator==(const Vec3& a, const Vec3& b) {
+  return a.x == b.x && a.y == b.y && a.z == b.z;
+}
+inline bool operator!=(const Vec3& a, const Vec3& b) { return !(a == b); }
+inline double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
+inline bool isFinite(const Vec3& a) {
+  return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
+}
+inline bool isZero(const Vec3& a) { return a.x == 0.0 && a.y == 0.0 && a.z == 0.0; }
+
+/// The part of `a` orthogonal to the unit vector `n`: a - (a . n) n.
+inline Vec3 tangentialPart(const Vec3& a, const Vec3& n) { return a - dot(a, n) * n; }
+
+/// A rigid pose: position (m, world frame) and rotation matrix R (row-major, body to world:
+/// x_world = R x_body + position).
+struct Pose {
+  Vec3 position;
+  double rotation[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+
+  /// R a: a direction from the body frame to the world frame.
+  Vec3 rotate(const Vec3& a) const {
+    const double* r = rotation;
+    return {r[0] * a.x + r[1] * a.y + r[2] * a.z, r[3] * a.x + r[4] * a.y + r[5] * a.z,
+            r[6] * a.x + r[7] * a.y + r[8] * a.z};
+  }
+  /// R a + position: a point from the body frame to the world frame (m).
+  Vec3 transform(const Vec3& a) const { return rotate(a) + position; }
+};
+
+}  // namespace rheofeed

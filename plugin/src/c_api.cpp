@@ -1,0 +1,184 @@
+// SPDX-License-Identifier: MIT
+// The C API: a thin shell over rheofeed::FeederSet that turns exceptions into result codes.
+#include "rheofeed/rheofeed.h"
+
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "rheofeed/feeder_set.hpp"
+
+struct rfFeederSet {
+  rheofeed::FeederSet set;
+  std::string last_error;
+  explicit rfFeederSet(const rheofeed::FeederSet::Options& options) : set(options) {}
+};
+
+namespace {
+
+using rheofeed::Frame;
+using rheofeed::MotionLaw;
+using rheofeed::Vec3;
+
+Vec3 vec(const double* a) { return a ? Vec3{a[0], a[1], a[2]} : Vec3{}; }
+
+// Runs `action` and maps exceptions onto result codes, keeping the message.
+template <class Action>
+int guarded(rfFeederSetID set, Action&& action) {
+  if (!set) return rfErrorInvalidArgument;
+  set->last_error.clear();
+  try {
+    action();
+    return rfOK;
+  } catch (const std::invalid_argument& e) {
+    set->last_error = e.what();
+    return rfErrorInvalidArgument;
+  } catch (const std::bad_alloc&) {
+    set->last_error = "out of memory";
+    return rfErrorOutOfMemory;
+  } catch (const std::exception& e) {
+    set->last_error = e.what();
+    return rfErrorInternal;
+  } catch (...) {
+    set->last_error = "unknown error";
+    return rfErrorInternal;
+  }
+}
+
+Frame frameOf(int frame) {
+  if (frame == rfFrameWorld) return Frame::World;
+  if (frame == rfFrameBody) return Frame::Body;
+  throw std::invalid_argument("frame = " + std::to_string(frame) +
+                              " is neither rfFrameWorld (0) nor rfFrameBody (1)");
+}
+
+void requireVector(const double* a, const char* name) {
+  if (!a) throw std::invalid_argument(std::string(name) + " is a null pointer");
+}
+
+MotionLaw twistLaw(const double* linear, const double* angular, const double* origin,
+                   int frame) {
+  requireVector(linear, "linear");
+  requireVector(angular, "angular");
+  requireVector(origin, "origin");
+  return MotionLaw::twist({vec(linear), vec(angular), vec(origin)}, frameOf(frame));
+}
+
+MotionLaw beltLaw(const double* direction, double speed, int frame) {
+  requireVector(direction, "direction");
+  return MotionLaw::belt(vec(direction), speed, frameOf(frame));
+}
+
+}  // namespace
+
+extern "C" {
+
+rfFeederSetID rfFeederSetCreate(void) { return rfFeederSetCreateWithOptions(1, 0, 1e-9); }
+
+rfFeederSetID rfFeederSetCreateWithOptions(int force_approx1, int attach_order,
+                                           double min_surface_speed) {
+  if (attach_order != rfAttachG1First && attach_order != rfAttachG2First) return nullptr;
+  rheofeed::FeederSet::Options options;
+  options.force_approx1 = force_approx1 != 0;
+  options.attach_order = attach_order == rfAttachG1First ? rheofeed::AttachOrder::G1First
+                                                         : rheofeed::AttachOrder::G2First;
+  options.min_surface_speed = min_surface_speed;
+  try {
+    return new rfFeederSet(options);
+  } catch (...) {
+    return nullptr;
+  }
+}
+
+void rfFeederSetDestroy(rfFeederSetID set) { delete set; }
+
+int rfFeederSetAddTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
+                        const double angular[3], const double origin[3], int frame) {
+  return guarded(set, [&] { set->set.add(geom, twistLaw(linear, angular, origin, frame)); });
+}
+
+int rfFeederSetAddBelt(rfFeederSetID set, dGeomID geom, const double direction[3], double speed,
+                       int frame) {
+  return guarded(set, [&] { set->set.add(geom, beltLaw(direction, speed, frame)); });
+}
+
+int rfFeederSetAddField(rfFeederSetID set, dGeomID geom, rfFieldFunction* field, void* user,
+                        int time_varying) {
+  return guarded(set, [&] {
+    if (!field) throw std::invalid_argument("field function is a null pointer");
+    auto wrapped = [field, user](const Vec3& p, const Vec3& n, double t) {
+      const double pa[3] = {p.x, p.y, p.z}, na[3] = {n.x, n.y, n.z};
+      double out[3] = {0, 0, 0};
+      field(user, pa, na, t, out);
+      return Vec3{out[0], out[1], out[2]};
+    };
+    set->set.add(geom, MotionLaw::field(wrapped, time_varying != 0));
+  });
+}
+
+int rfFeederSetSetTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
+                        const double angular[3], const double origin[3], int frame) {
+  return guarded(set, [&] { set->set.setLaw(geom, twistLaw(linear, angular, origin, frame)); });
+}
+
+int rfFeederSetSetBelt(rfFeederSetID set, dGeomID geom, const double direction[3], double speed,
+                       int frame) {
+  return guarded(set, [&] { set->set.setLaw(geom, beltLaw(direction, speed, frame)); });
+}
+
+int rfFeederSetSetRamp(rfFeederSetID set, dGeomID geom, double t_start, double t_end,
+                       double from, double to) {
+  return guarded(set, [&] {
+    const MotionLaw& law = set->set.law(geom);
+    set->set.setLaw(geom,
+                    law.withProfile(rheofeed::TimeProfile::ramp(t_start, t_end, from, to)));
+  });
+}
+
+int rfFeederSetSetOnOff(rfFeederSetID set, dGeomID geom, double t_on, double t_off) {
+  return guarded(set, [&] {
+    const MotionLaw& law = set->set.law(geom);
+    set->set.setLaw(geom, law.withProfile(rheofeed::TimeProfile::onOff(t_on, t_off)));
+  });
+}
+
+int rfFeederSetRemove(rfFeederSetID set, dGeomID geom) {
+  return guarded(set, [&] { set->set.remove(geom); });
+}
+
+int rfFeederSetContains(rfFeederSetID set, dGeomID geom) {
+  return set && set->set.contains(geom) ? 1 : 0;
+}
+
+int rfFeederSetBeginStep(rfFeederSetID set, double time) {
+  return guarded(set, [&] { set->set.beginStep(time); });
+}
+
+int rfFeederSetDriveContacts(rfFeederSetID set, dContact* contacts, int count) {
+  if (!set) return rfErrorInvalidArgument;
+  return set->set.driveContacts(contacts, count);
+}
+
+int rfFeederSetGetContactsDriven(rfFeederSetID set, dGeomID geom) {
+  int driven = 0;
+  const int rc = guarded(set, [&] { driven = set->set.stats(geom).contacts_driven; });
+  return rc == rfOK ? driven : rc;
+}
+
+void rfFeederSetSetDiagnosticFunction(rfFeederSetID set, rfDiagnosticFunction* fn, void* user) {
+  if (!set) return;
+  if (!fn) {
+    set->set.setDiagnosticHandler(nullptr);
+    return;
+  }
+  set->set.setDiagnosticHandler([fn, user](const rheofeed::Diagnostic& d) {
+    fn(user, rheofeed::toString(d.kind), d.feeder, d.message.c_str());
+  });
+}
+
+const char* rfFeederSetGetLastError(rfFeederSetID set) {
+  return set ? set->last_error.c_str() : "set is a null pointer";
+}
+
+}  // extern "C"

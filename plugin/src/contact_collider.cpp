@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: MIT
+#include "rheofeed/contact_collider.hpp"
+
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace rheofeed {
+
+ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders)
+    : ContactCollider(world, feeders, Settings{}) {}
+
+ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders, const Settings& settings)
+    : world_(world), feeders_(feeders), settings_(settings), group_(nullptr) {
+  if (!world) throw std::invalid_argument("rheofeed::ContactCollider: world is null");
+  if (settings.max_contacts_per_pair < 1 || settings.max_contacts_per_pair > 0xffff) {
+    throw std::invalid_argument("rheofeed::ContactCollider: Settings::max_contacts_per_pair = " +
+                                std::to_string(settings.max_contacts_per_pair) +
+                                " must be in 1..65535");
+  }
+  buffer_.resize(static_cast<std::size_t>(settings.max_contacts_per_pair));
+  group_ = dJointGroupCreate(0);
+}
+
+ContactCollider::~ContactCollider() { dJointGroupDestroy(group_); }
+
+void ContactCollider::setSurfaceCallback(SurfaceCallback callback) {
+  surface_ = std::move(callback);
+}
+
+void ContactCollider::clearJoints() {
+  dJointGroupEmpty(group_);
+  contact_count_ = 0;
+  feedback_used_ = 0;
+}
+
+void ContactCollider::collide(dSpaceID space, double time) {
+  clearJoints();
+  feeders_.beginStep(time);
+  collideWithin(space);
+}
+
+void ContactCollider::collideWithin(dSpaceID space) {
+  // Pairs inside `space` (a sub-space against a geom or another sub-space is split further by
+  // nearCallback), then the pairs inside each sub-space, each exactly once.
+  dSpaceCollide(space, this, &ContactCollider::nearCallback);
+  const int count = dSpaceGetNumGeoms(space);
+  for (int i = 0; i < count; ++i) {
+    dGeomID child = dSpaceGetGeom(space, i);
+    if (dGeomIsSpace(child)) collideWithin(reinterpret_cast<dSpaceID>(child));
+  }
+}
+
+void ContactCollider::nearCallback(void* data, dGeomID o1, dGeomID o2) {
+  auto* self = static_cast<ContactCollider*>(data);
+  if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) {
+    dSpaceCollide2(o1, o2, data, &ContactCollider::nearCallback);
+    return;
+  }
+  self->handlePair(o1, o2);
+}
+
+void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
+  dBodyID b1 = dGeomGetBody(o1);
+  dBodyID b2 = dGeomGetBody(o2);
+  if (!b1 && !b2) return;  // two static geoms: nothing to constrain
+  if (settings_.skip_connected_bodies && b1 && b2 &&
+      dAreConnectedExcluding(b1, b2, dJointTypeContact)) {
+    return;
+  }
+  dContact* contacts = buffer_.data();
+  int n = dCollide(o1, o2, settings_.max_contacts_per_pair, &contacts[0].geom, sizeof(dContact));
+  if (n <= 0) return;
+  for (int i = 0; i < n; ++i) contacts[i].surface = settings_.default_surface;
+  if (surface_ && !surface_(o1, o2, contacts, n)) return;
+
+  std::vector<ContactRecord>& records = feeders_.records();
+  const std::size_t first_record = records.size();
+  n = feeders_.driveContacts(contacts, n);
+  const bool recorded = records.size() > first_record;
+  std::size_t next_record = first_record;
+  const bool feeder_pair = recorded && (feeders_.contains(o1) || feeders_.contains(o2));
+
+  for (int i = 0; i < n; ++i) {
+    dJointID joint = dJointCreateContact(world_, group_, &contacts[i]);
+    dBodyID a = dGeomGetBody(contacts[i].geom.g1);
+    dBodyID b = dGeomGetBody(contacts[i].geom.g2);
+    if (feeders_.options().attach_order == AttachOrder::G2First) std::swap(a, b);
+    dJointAttach(joint, a, b);
+    ++contact_count_;
+    if (feeder_pair && next_record < records.size()) {
+      ContactRecord& r = records[next_record++];
+      r.joint = joint;
+      if (settings_.feedback) {
+        if (feedback_used_ == feedback_.size()) feedback_.emplace_back();
+        dJointFeedback* fb = &feedback_[feedback_used_++];
+        dJointSetFeedback(joint, fb);
+        r.feedback = fb;
+      }
+    }
+  }
+}
+
+}  // namespace rheofeed

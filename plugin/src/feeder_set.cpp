@@ -1,0 +1,408 @@
+// SPDX-License-Identifier: MIT
+#include "rheofeed/feeder_set.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "ode_vec.hpp"
+
+namespace rheofeed {
+namespace {
+
+// Up to this many feeders a linear scan over a contiguous array beats hashing (the common case:
+// one to a few feeders). More feeders switch to the hash map.
+constexpr std::size_t kLinearLookupLimit = 8;
+constexpr int kDiagnosticKinds = 4;
+
+std::string geomName(dGeomID geom) {
+  std::ostringstream out;
+  out << "feeder geom " << static_cast<const void*>(geom);
+  return out.str();
+}
+
+}  // namespace
+
+void requireDoublePrecisionOde() {
+  static const bool is_double = dCheckConfiguration("ODE_double_precision") != 0;
+  if (!is_double) {
+    throw std::runtime_error(
+        std::string("rheofeed needs ODE built in double precision; the loaded ODE reports "
+                    "configuration \"") +
+        dGetConfiguration() + "\"");
+  }
+}
+
+const char* toString(DiagnosticKind kind) {
+  switch (kind) {
+    case DiagnosticKind::InvalidContact:
+      return "invalid_contact";
+    case DiagnosticKind::ZeroFriction:
+      return "zero_friction";
+    case DiagnosticKind::LawNotFinite:
+      return "law_not_finite";
+    case DiagnosticKind::ForceCapFriction:
+      return "force_cap_friction";
+  }
+  return "unknown";
+}
+
+struct FeederSet::Impl {
+  struct Feeder {
+    dGeomID geom = nullptr;
+    MotionLaw law;
+    StepLaw frozen;                      // law frozen at `frozen_step`
+    std::uint64_t frozen_step = ~std::uint64_t{0};
+    bool replaced = true;                // law set or replaced since last frozen
+    bool changed = false;                // frozen motion differs from the previous one: wake
+    FeederStats stats;
+    bool reported[kDiagnosticKinds] = {};
+  };
+
+  Options options;
+  std::vector<std::unique_ptr<Feeder>> feeders;
+  std::vector<dGeomID> geoms;  // parallel to feeders, for the linear lookup
+  std::unordered_map<dGeomID, Feeder*> by_geom;
+  double time = 0.0;
+  std::uint64_t step = 0;
+  std::vector<ContactRecord> records;
+  std::function<void(const Diagnostic&)> handler;
+
+  Feeder* find(dGeomID geom) const {
+    if (feeders.size() <= kLinearLookupLimit) {
+      for (std::size_t i = 0; i < geoms.size(); ++i) {
+        if (geoms[i] == geom) return feeders[i].get();
+      }
+      return nullptr;
+    }
+    auto it = by_geom.find(geom);
+    return it == by_geom.end() ? nullptr : it->second;
+  }
+
+  Feeder& require(dGeomID geom, const char* what) const {
+    Feeder* f = geom ? find(geom) : nullptr;
+    if (!f) {
+      std::ostringstream out;
+      out << "rheofeed::FeederSet::" << what << ": geom " << static_cast<const void*>(geom)
+          << (geom ? " is not a registered feeder" : " is null");
+      throw std::invalid_argument(out.str());
+    }
+    return *f;
+  }
+
+  void checkLaw(dGeomID geom, const MotionLaw& law, const char* what) const {
+    const std::string where = std::string("rheofeed::FeederSet::") + what + ": " + geomName(geom);
+    law.validate(where);
+    if (law.frame() == Frame::Body && dGeomGetBody(geom) == nullptr) {
+      throw std::invalid_argument(where + ": law uses Frame::Body but the geom has no body");
+    }
+  }
+
+  // The law of `f` frozen at the current step; computed on the step's first contact.
+  const StepLaw& frozen(Feeder& f) {
+    if (f.frozen_step == step) return f.frozen;
+    Pose pose;
+    const Pose* body_pose = nullptr;
+    if (f.law.frame() == Frame::Body) {
+      if (dBodyID body = dGeomGetBody(f.geom)) {
+        pose = poseOf(body);
+        body_pose = &pose;
+      }
+    }
+    StepLaw next = f.law.evaluate(time, body_pose);
+    f.changed = f.replaced || !next.sameMotionAs(f.frozen);
+    f.replaced = false;
+    f.frozen = std::move(next);
+    f.frozen_step = step;
+    return f.frozen;
+  }
+
+  void report(Feeder& f, DiagnosticKind kind, const std::string& message) noexcept {
+    try {
+      Diagnostic d{kind, f.geom, geomName(f.geom) + ": " + message};
+      if (handler) {
+        handler(d);
+      } else if (!f.reported[static_cast<int>(kind)]) {
+        std::fprintf(stderr, "rheofeed [%s]: %s (further reports of this kind are counted in "
+                     "FeederStats)\n", toString(kind), d.message.c_str());
+      }
+    } catch (...) {
+      // A diagnostic must never unwind into ODE.
+    }
+    f.reported[static_cast<int>(kind)] = true;
+  }
+
+  static void wake(dBodyID body, Feeder& f) {
+    if (body && !dBodyIsEnabled(body)) {
+      dBodyEnable(body);
+      ++f.stats.bodies_woken;
+    }
+  }
+
+  // Whether the contact data is safe to hand to ODE (cheap: runs on every feeder contact).
+  static bool contactValid(const dContact& c) {
+    const dContactGeom& g = c.geom;
+    bool ok = std::isfinite(g.depth) && c.surface.mu >= 0;  // false for NaN mu
+    for (int k = 0; k < 3; ++k) ok = ok && std::isfinite(g.pos[k]) && std::isfinite(g.normal[k]);
+    if (c.surface.mode & dContactMu2) ok = ok && c.surface.mu2 >= 0;
+    return ok;
+  }
+
+  // Names the first bad value of an invalid contact.
+  static std::string contactProblem(const dContact& c) {
+    const dContactGeom& g = c.geom;
+    std::ostringstream out;
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(g.pos[k])) {
+        out << "contact pos[" << k << "] = " << g.pos[k] << " is not finite";
+        return out.str();
+      }
+      if (!std::isfinite(g.normal[k])) {
+        out << "contact normal[" << k << "] = " << g.normal[k] << " is not finite";
+        return out.str();
+      }
+    }
+    if (!std::isfinite(g.depth)) {
+      out << "contact depth = " << g.depth << " is not finite";
+      return out.str();
+    }
+    if (std::isnan(c.surface.mu) || c.surface.mu < 0) {
+      out << "contact mu = " << c.surface.mu << (c.surface.mu < 0 ? " is negative" : " is NaN");
+      return out.str();
+    }
+    if ((c.surface.mode & dContactMu2) && (std::isnan(c.surface.mu2) || c.surface.mu2 < 0)) {
+      out << "contact mu2 = " << c.surface.mu2
+          << (c.surface.mu2 < 0 ? " is negative" : " is NaN");
+      return out.str();
+    }
+    return {};
+  }
+};
+
+FeederSet::FeederSet() : FeederSet(Options{}) {}
+
+FeederSet::FeederSet(const Options& options) : impl_(std::make_unique<Impl>()) {
+  requireDoublePrecisionOde();
+  if (!(options.min_surface_speed >= 0) || !std::isfinite(options.min_surface_speed)) {
+    std::ostringstream out;
+    out << "rheofeed::FeederSet: Options::min_surface_speed = " << options.min_surface_speed
+        << " must be finite and >= 0 (m/s)";
+    throw std::invalid_argument(out.str());
+  }
+  impl_->options = options;
+}
+
+FeederSet::~FeederSet() = default;
+FeederSet::FeederSet(FeederSet&&) noexcept = default;
+FeederSet& FeederSet::operator=(FeederSet&&) noexcept = default;
+
+void FeederSet::add(dGeomID geom, MotionLaw law) {
+  if (!geom) throw std::invalid_argument("rheofeed::FeederSet::add: geom is null");
+  if (impl_->find(geom)) {
+    throw std::invalid_argument("rheofeed::FeederSet::add: " + geomName(geom) +
+                                " is already registered (use setLaw to change its law)");
+  }
+  impl_->checkLaw(geom, law, "add");
+  auto feeder = std::make_unique<Impl::Feeder>();
+  feeder->geom = geom;
+  feeder->law = std::move(law);
+  impl_->by_geom.emplace(geom, feeder.get());
+  impl_->geoms.push_back(geom);
+  impl_->feeders.push_back(std::move(feeder));
+}
+
+void FeederSet::setLaw(dGeomID geom, MotionLaw law) {
+  Impl::Feeder& f = impl_->require(geom, "setLaw");
+  impl_->checkLaw(geom, law, "setLaw");
+  f.law = std::move(law);
+  f.replaced = true;
+  f.frozen_step = ~std::uint64_t{0};
+  // The frozen law points into the old law's field; it is recomputed before any use.
+  f.frozen = StepLaw{};
+}
+
+void FeederSet::remove(dGeomID geom) {
+  impl_->require(geom, "remove");
+  for (std::size_t i = 0; i < impl_->geoms.size(); ++i) {
+    if (impl_->geoms[i] != geom) continue;
+    impl_->geoms.erase(impl_->geoms.begin() + static_cast<std::ptrdiff_t>(i));
+    impl_->feeders.erase(impl_->feeders.begin() + static_cast<std::ptrdiff_t>(i));
+    break;
+  }
+  impl_->by_geom.erase(geom);
+}
+
+bool FeederSet::contains(dGeomID geom) const { return geom && impl_->find(geom) != nullptr; }
+
+const MotionLaw& FeederSet::law(dGeomID geom) const { return impl_->require(geom, "law").law; }
+
+int FeederSet::size() const { return static_cast<int>(impl_->feeders.size()); }
+
+void FeederSet::beginStep(double time) {
+  if (!std::isfinite(time)) {
+    std::ostringstream out;
+    out << "rheofeed::FeederSet::beginStep: time = " << time << " is not finite";
+    throw std::invalid_argument(out.str());
+  }
+  impl_->time = time;
+  ++impl_->step;
+  for (auto& f : impl_->feeders) {
+    f->stats.contacts_driven = 0;
+    f->stats.contacts_undriven = 0;
+  }
+  impl_->records.clear();
+}
+
+double FeederSet::time() const { return impl_->time; }
+
+int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
+  Impl& s = *impl_;
+  if (!contacts || count <= 0 || s.feeders.empty()) return count < 0 ? 0 : count;
+  const Options& opt = s.options;
+
+  // Contacts of one dCollide call share their geoms: look the pair up once.
+  dGeomID last_g1 = nullptr, last_g2 = nullptr;
+  Impl::Feeder* f1 = nullptr;
+  Impl::Feeder* f2 = nullptr;
+  int kept = 0;
+  for (int i = 0; i < count; ++i) {
+    dContact& c = contacts[i];
+    const dGeomID g1 = c.geom.g1, g2 = c.geom.g2;
+    if (g1 != last_g1 || g2 != last_g2) {
+      f1 = s.find(g1);
+      f2 = s.find(g2);
+      last_g1 = g1;
+      last_g2 = g2;
+    }
+    if (!f1 && !f2) {  // not a feeder contact: untouched
+      if (kept != i) contacts[kept] = c;
+      ++kept;
+      continue;
+    }
+    Impl::Feeder& primary = f1 ? *f1 : *f2;
+
+    if (!Impl::contactValid(c)) {
+      ++primary.stats.invalid_contacts;
+      s.report(primary, DiagnosticKind::InvalidContact,
+               Impl::contactProblem(c) + "; contact removed");
+      continue;
+    }
+
+    // ODE's row order: node0 is the body attached first, unless it is 0 and the other is not.
+    dGeomID first = opt.attach_order == AttachOrder::G1First ? g1 : g2;
+    dGeomID second = first == g1 ? g2 : g1;
+    dBodyID b_first = dGeomGetBody(first), b_second = dGeomGetBody(second);
+    if (!b_first && b_second) {
+      std::swap(first, second);
+      std::swap(b_first, b_second);
+    }
+    Impl::Feeder* f_first = first == g1 ? f1 : f2;
+    Impl::Feeder* f_second = first == g1 ? f2 : f1;
+
+    const Vec3 p = toVec3(c.geom.pos);
+    const Vec3 n = toVec3(c.geom.normal);
+    Vec3 c_first, c_second;
+    bool finite = true;
+    for (Impl::Feeder* f : {f_first, f_second}) {
+      if (!f) continue;
+      const StepLaw& law = s.frozen(*f);
+      Vec3 value;
+      if (!law.finite()) {
+        finite = false;
+        s.report(*f, DiagnosticKind::LawNotFinite, law.problem() + "; contact left undriven");
+      } else {
+        value = law.tangentialVelocity(p, n);
+        if (!isFinite(value)) {
+          finite = false;
+          std::ostringstream out;
+          out << "law gave surface velocity (" << value.x << ", " << value.y << ", " << value.z
+              << ") at p = (" << p.x << ", " << p.y << ", " << p.z << "), t = " << s.time
+              << "; contact left undriven";
+          s.report(*f, DiagnosticKind::LawNotFinite, out.str());
+        }
+      }
+      (f == f_first ? c_first : c_second) = value;
+      if (f->changed) {  // the law changed: wake sleeping parts on it
+        Impl::wake(b_first, *f);
+        Impl::wake(b_second, *f);
+      }
+    }
+
+    dSurfaceParameters& surf = c.surface;
+    if (opt.force_approx1) {
+      surf.mode |= dContactApprox1;
+    } else if ((surf.mode & dContactApprox1) == 0 &&
+               !primary.reported[static_cast<int>(DiagnosticKind::ForceCapFriction)]) {
+      s.report(primary, DiagnosticKind::ForceCapFriction,
+               "contact without dContactApprox1: mu = " + std::to_string(surf.mu) +
+                   " is a force cap in newtons, not a coefficient");
+    }
+    if (surf.mu == 0) {
+      ++primary.stats.zero_friction;
+      s.report(primary, DiagnosticKind::ZeroFriction,
+               "contact mu = 0: ODE applies no friction, so the surface motion has no effect");
+    }
+
+    const Vec3 c_rel = tangentialPart(c_second - c_first, n);
+    const double speed = finite ? norm(c_rel) : 0.0;
+    surf.mode &= ~(dContactMotion2);
+    surf.motion2 = 0;
+    if (!finite) ++primary.stats.law_not_finite;
+    if (!(speed > opt.min_surface_speed)) {
+      surf.mode &= ~(dContactFDir1 | dContactMotion1);
+      surf.motion1 = 0;
+      ++primary.stats.contacts_undriven;
+    } else {
+      const Vec3 t = (1.0 / speed) * c_rel;
+      c.fdir1[0] = t.x;
+      c.fdir1[1] = t.y;
+      c.fdir1[2] = t.z;
+      c.fdir1[3] = 0;
+      surf.motion1 = speed;
+      surf.mode |= dContactFDir1 | dContactMotion1;
+      ++primary.stats.contacts_driven;
+      if (f1 && f2) ++f2->stats.contacts_driven;
+    }
+
+    if (opt.record_contacts) {
+      try {
+        const bool feeder_is_g1 = f1 != nullptr;
+        const Vec3 c_g1 = first == g1 ? c_first : c_second;
+        const Vec3 c_g2 = first == g1 ? c_second : c_first;
+        ContactRecord r;
+        r.feeder = feeder_is_g1 ? g1 : g2;
+        r.part = feeder_is_g1 ? g2 : g1;
+        r.position = p;
+        r.normal = n;
+        r.surface_velocity = feeder_is_g1 ? c_g1 - c_g2 : c_g2 - c_g1;
+        s.records.push_back(r);
+      } catch (...) {
+        // Out of memory while recording: observation only, the contact stays driven.
+      }
+    }
+    if (kept != i) contacts[kept] = c;
+    ++kept;
+  }
+  return kept;
+}
+
+FeederStats FeederSet::stats(dGeomID geom) const { return impl_->require(geom, "stats").stats; }
+
+const std::vector<ContactRecord>& FeederSet::records() const { return impl_->records; }
+std::vector<ContactRecord>& FeederSet::records() { return impl_->records; }
+
+Vec3 FeederSet::slip(const ContactRecord& r) const {
+  const Vec3 v_part = pointVelocity(dGeomGetBody(r.part), r.position);
+  const Vec3 v_feeder = pointVelocity(dGeomGetBody(r.feeder), r.position);
+  return tangentialPart(v_part - v_feeder - r.surface_velocity, r.normal);
+}
+
+void FeederSet::setDiagnosticHandler(std::function<void(const Diagnostic&)> handler) {
+  impl_->handler = std::move(handler);
+}
+
+const FeederSet::Options& FeederSet::options() const { return impl_->options; }
+
+}  // namespace rheofeed
