@@ -14,40 +14,28 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "rheofeed/contact_collider.hpp"
 #include "rheofeed/feeder_set.hpp"
+#include "rheofeed/scene/output.hpp"
 
 namespace {
 
-constexpr double kFeedSpeed = 0.2;     // m/s, first belt
-constexpr double kTransferSpeed = 0.5; // m/s, second belt
-constexpr double kMu = 0.6;            // friction coefficient part-belt
-constexpr double kSpawnPeriod = 0.4;   // s between parts
-constexpr double kPartSize = 0.05;     // m, cube edge
-constexpr double kPartMass = 0.1;      // kg
+constexpr double kFeedSpeed = 0.2;      // m/s, first belt
+constexpr double kTransferSpeed = 0.5;  // m/s, second belt
+constexpr double kMu = 0.6;             // friction coefficient part-belt
+constexpr double kSpawnPeriod = 0.4;    // s between parts
+constexpr double kPartSize = 0.05;      // m, cube edge
+constexpr double kPartMass = 0.1;       // kg
 
 struct Options {
   double duration = 6.0;  // s
   double dt = 0.01;       // s
   std::string out = "out/belt_conveyor";
 };
-
-// Writes `text` to `path` atomically: a crash never leaves a half-written file.
-void writeFileAtomically(const std::filesystem::path& path, const std::string& text) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::trunc);
-    if (!f) throw std::runtime_error("cannot write " + tmp.string());
-    f << text;
-    if (!f.flush()) throw std::runtime_error("write failed: " + tmp.string());
-  }
-  std::filesystem::rename(tmp, path);
-}
 
 int run(const Options& opt) {
   dInitODE2(0);
@@ -76,8 +64,9 @@ int run(const Options& opt) {
   });
 
   std::vector<dBodyID> parts;
-  std::string csv = "time_s,parts,mean_vx_feed_mps,mean_vx_transfer_mps,contacts_feed,"
-                    "contacts_transfer\n";
+  std::string csv =
+      "time_s,parts,mean_vx_feed_mps,mean_vx_transfer_mps,contacts_feed,"
+      "contacts_transfer\n";
   const int steps = static_cast<int>(std::lround(opt.duration / opt.dt));
   double next_spawn = 0.0;
   for (int k = 0; k < steps; ++k) {
@@ -99,8 +88,14 @@ int run(const Options& opt) {
     int n_feed = 0, n_transfer = 0;
     for (dBodyID b : parts) {
       const double x = dBodyGetPosition(b)[0], vx = dBodyGetLinearVel(b)[0];
-      if (x < -0.1 && x > -0.8) { sum_feed += vx; ++n_feed; }
-      if (x > 0.2 && x < 1.9) { sum_transfer += vx; ++n_transfer; }
+      if (x < -0.1 && x > -0.8) {
+        sum_feed += vx;
+        ++n_feed;
+      }
+      if (x > 0.2 && x < 1.9) {
+        sum_transfer += vx;
+        ++n_transfer;
+      }
     }
     char line[256];
     std::snprintf(line, sizeof line, "%.4f,%zu,%.6f,%.6f,%d,%d\n", t + opt.dt, parts.size(),
@@ -120,12 +115,12 @@ int run(const Options& opt) {
     const double x = dBodyGetPosition(b)[0], vx = dBodyGetLinearVel(b)[0];
     if (x > 0.3 && x < 1.9) worst = std::max(worst, std::abs(vx - kTransferSpeed));
   }
-  std::filesystem::create_directories(opt.out);
   const auto csv_path = std::filesystem::path(opt.out) / "belt_conveyor.csv";
-  writeFileAtomically(csv_path, csv);
-  std::printf("belt_conveyor: %zu parts in %.2f s simulated; parts on the transfer belt deviate "
-              "at most %.2e m/s from its %.2f m/s\nwrote %s\n",
-              parts.size(), opt.duration, worst, kTransferSpeed, csv_path.c_str());
+  rheofeed::scene::writeFileAtomically(csv_path, csv);
+  std::printf(
+      "belt_conveyor: %zu parts in %.2f s simulated; parts on the transfer belt deviate "
+      "at most %.2e m/s from its %.2f m/s\nwrote %s\n",
+      parts.size(), opt.duration, worst, kTransferSpeed, csv_path.c_str());
 
   collider.clearJoints();  // contact joints go before their world
   dSpaceDestroy(space);

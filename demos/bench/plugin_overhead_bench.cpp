@@ -33,9 +33,9 @@ using rheofeed::FeederSet;
 using rheofeed::MotionLaw;
 
 constexpr int kMaxContacts = 8;
-constexpr double kStep = 0.005;      // s
-constexpr int kSettleSteps = 100;    // untimed steps before timing: the pile is in contact
-constexpr int kTimedSteps = 200;     // steps per repetition
+constexpr double kStep = 0.005;    // s
+constexpr int kSettleSteps = 100;  // untimed steps before timing: the pile is in contact
+constexpr int kTimedSteps = 200;   // steps per repetition
 constexpr int kRepetitions = 15;
 int g_boxes = 400;
 
@@ -135,16 +135,25 @@ void BM_DriveContacts(benchmark::State& state) {
   dGeomID part = dCreateBox(nullptr, 1, 1, 1);
   FeederSet set;
   switch (kind) {
-    case 1: set.add(feeder, MotionLaw::belt({1, 0, 0}, 0.3)); break;  // contacts use `part` only
-    case 2: set.add(feeder, MotionLaw::belt({1, 0, 0}, 0.3)); break;
-    case 3: set.add(feeder, MotionLaw::translation({0.3, 0, 0})); break;
-    case 4: set.add(feeder, MotionLaw::rotation({0, 0, 1}, {0, 0, 0})); break;
+    case 1:
+      set.add(feeder, MotionLaw::belt({1, 0, 0}, 0.3));
+      break;  // contacts use `part` only
+    case 2:
+      set.add(feeder, MotionLaw::belt({1, 0, 0}, 0.3));
+      break;
+    case 3:
+      set.add(feeder, MotionLaw::translation({0.3, 0, 0}));
+      break;
+    case 4:
+      set.add(feeder, MotionLaw::rotation({0, 0, 1}, {0, 0, 0}));
+      break;
     case 5:
       set.add(feeder, MotionLaw::field([](const rheofeed::Vec3& p, const rheofeed::Vec3&, double) {
                 return rheofeed::Vec3{-p.y, p.x, 0};
               }));
       break;
-    default: break;
+    default:
+      break;
   }
   constexpr int kCount = 64;
   std::vector<dContact> tmpl(kCount), work(kCount);
@@ -230,8 +239,9 @@ int main(int argc, char** argv) {
                 wrapped / plain);
   }
   if (plain > 0 && ground > 0) {
-    std::printf("| pile step, ground is a feeder (all ground contacts driven) / plain ODE | %.4f |\n",
-                ground / plain);
+    std::printf(
+        "| pile step, ground is a feeder (all ground contacts driven) / plain ODE | %.4f |\n",
+        ground / plain);
   }
   const double copy = get("BM_DriveContacts/law:0");
   const char* names[] = {"", "no-feeder contact", "belt", "translation", "twist", "field"};

@@ -21,7 +21,9 @@ using rheofeed::Frame;
 using rheofeed::MotionLaw;
 using rheofeed::Vec3;
 
-Vec3 vec(const double* a) { return a ? Vec3{a[0], a[1], a[2]} : Vec3{}; }
+Vec3 vec(const double* a) {
+  return a ? Vec3{a[0], a[1], a[2]} : Vec3{};
+}
 
 // Runs `action` and maps exceptions onto result codes, keeping the message.
 template <class Action>
@@ -57,8 +59,7 @@ void requireVector(const double* a, const char* name) {
   if (!a) throw std::invalid_argument(std::string(name) + " is a null pointer");
 }
 
-MotionLaw twistLaw(const double* linear, const double* angular, const double* origin,
-                   int frame) {
+MotionLaw twistLaw(const double* linear, const double* angular, const double* origin, int frame) {
   requireVector(linear, "linear");
   requireVector(angular, "angular");
   requireVector(origin, "origin");
@@ -74,7 +75,9 @@ MotionLaw beltLaw(const double* direction, double speed, int frame) {
 
 extern "C" {
 
-rfFeederSetID rfFeederSetCreate(void) { return rfFeederSetCreateWithOptions(1, 0, 1e-9); }
+rfFeederSetID rfFeederSetCreate(void) {
+  return rfFeederSetCreateWithOptions(1, 0, 1e-9);
+}
 
 rfFeederSetID rfFeederSetCreateWithOptions(int force_approx1, int attach_order,
                                            double min_surface_speed) {
@@ -91,7 +94,9 @@ rfFeederSetID rfFeederSetCreateWithOptions(int force_approx1, int attach_order,
   }
 }
 
-void rfFeederSetDestroy(rfFeederSetID set) { delete set; }
+void rfFeederSetDestroy(rfFeederSetID set) {
+  delete set;
+}
 
 int rfFeederSetAddTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
                         const double angular[3], const double origin[3], int frame) {
@@ -127,12 +132,11 @@ int rfFeederSetSetBelt(rfFeederSetID set, dGeomID geom, const double direction[3
   return guarded(set, [&] { set->set.setLaw(geom, beltLaw(direction, speed, frame)); });
 }
 
-int rfFeederSetSetRamp(rfFeederSetID set, dGeomID geom, double t_start, double t_end,
-                       double from, double to) {
+int rfFeederSetSetRamp(rfFeederSetID set, dGeomID geom, double t_start, double t_end, double from,
+                       double to) {
   return guarded(set, [&] {
     const MotionLaw& law = set->set.law(geom);
-    set->set.setLaw(geom,
-                    law.withProfile(rheofeed::TimeProfile::ramp(t_start, t_end, from, to)));
+    set->set.setLaw(geom, law.withProfile(rheofeed::TimeProfile::ramp(t_start, t_end, from, to)));
   });
 }
 

@@ -22,7 +22,9 @@ ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders, const Setti
   group_ = dJointGroupCreate(0);
 }
 
-ContactCollider::~ContactCollider() { dJointGroupDestroy(group_); }
+ContactCollider::~ContactCollider() {
+  dJointGroupDestroy(group_);
+}
 
 void ContactCollider::setSurfaceCallback(SurfaceCallback callback) {
   surface_ = std::move(callback);
@@ -30,7 +32,7 @@ void ContactCollider::setSurfaceCallback(SurfaceCallback callback) {
 
 void ContactCollider::clearJoints() {
   dJointGroupEmpty(group_);
-  contact_count_ = 0;
+  joints_.clear();
   feedback_used_ = 0;
 }
 
@@ -87,16 +89,19 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
     dBodyID b = dGeomGetBody(contacts[i].geom.g2);
     if (feeders_.options().attach_order == AttachOrder::G2First) std::swap(a, b);
     dJointAttach(joint, a, b);
-    ++contact_count_;
+    dJointFeedback* fb = nullptr;
+    if (settings_.feedback) {
+      if (feedback_used_ == feedback_.size()) feedback_.emplace_back();
+      fb = &feedback_[feedback_used_++];
+      dJointSetFeedback(joint, fb);
+    }
+    const dReal* n_i = contacts[i].geom.normal;
+    joints_.push_back(
+        {contacts[i].geom.g1, contacts[i].geom.g2, {n_i[0], n_i[1], n_i[2]}, joint, fb});
     if (feeder_pair && next_record < records.size()) {
       ContactRecord& r = records[next_record++];
       r.joint = joint;
-      if (settings_.feedback) {
-        if (feedback_used_ == feedback_.size()) feedback_.emplace_back();
-        dJointFeedback* fb = &feedback_[feedback_used_++];
-        dJointSetFeedback(joint, fb);
-        r.feedback = fb;
-      }
+      r.feedback = fb;
     }
   }
 }

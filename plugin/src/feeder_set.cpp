@@ -53,10 +53,10 @@ struct FeederSet::Impl {
   struct Feeder {
     dGeomID geom = nullptr;
     MotionLaw law;
-    StepLaw frozen;                      // law frozen at `frozen_step`
+    StepLaw frozen;  // law frozen at `frozen_step`
     std::uint64_t frozen_step = ~std::uint64_t{0};
-    bool replaced = true;                // law set or replaced since last frozen
-    bool changed = false;                // frozen motion differs from the previous one: wake
+    bool replaced = true;  // law set or replaced since last frozen
+    bool changed = false;  // frozen motion differs from the previous one: wake
     FeederStats stats;
     bool reported[kDiagnosticKinds] = {};
   };
@@ -125,8 +125,10 @@ struct FeederSet::Impl {
       if (handler) {
         handler(d);
       } else if (!f.reported[static_cast<int>(kind)]) {
-        std::fprintf(stderr, "rheofeed [%s]: %s (further reports of this kind are counted in "
-                     "FeederStats)\n", toString(kind), d.message.c_str());
+        std::fprintf(stderr,
+                     "rheofeed [%s]: %s (further reports of this kind are counted in "
+                     "FeederStats)\n",
+                     toString(kind), d.message.c_str());
       }
     } catch (...) {
       // A diagnostic must never unwind into ODE.
@@ -173,8 +175,7 @@ struct FeederSet::Impl {
       return out.str();
     }
     if ((c.surface.mode & dContactMu2) && (std::isnan(c.surface.mu2) || c.surface.mu2 < 0)) {
-      out << "contact mu2 = " << c.surface.mu2
-          << (c.surface.mu2 < 0 ? " is negative" : " is NaN");
+      out << "contact mu2 = " << c.surface.mu2 << (c.surface.mu2 < 0 ? " is negative" : " is NaN");
       return out.str();
     }
     return {};
@@ -234,11 +235,17 @@ void FeederSet::remove(dGeomID geom) {
   impl_->by_geom.erase(geom);
 }
 
-bool FeederSet::contains(dGeomID geom) const { return geom && impl_->find(geom) != nullptr; }
+bool FeederSet::contains(dGeomID geom) const {
+  return geom && impl_->find(geom) != nullptr;
+}
 
-const MotionLaw& FeederSet::law(dGeomID geom) const { return impl_->require(geom, "law").law; }
+const MotionLaw& FeederSet::law(dGeomID geom) const {
+  return impl_->require(geom, "law").law;
+}
 
-int FeederSet::size() const { return static_cast<int>(impl_->feeders.size()); }
+int FeederSet::size() const {
+  return static_cast<int>(impl_->feeders.size());
+}
 
 void FeederSet::beginStep(double time) {
   if (!std::isfinite(time)) {
@@ -255,7 +262,9 @@ void FeederSet::beginStep(double time) {
   impl_->records.clear();
 }
 
-double FeederSet::time() const { return impl_->time; }
+double FeederSet::time() const {
+  return impl_->time;
+}
 
 int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
   Impl& s = *impl_;
@@ -388,10 +397,16 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
   return kept;
 }
 
-FeederStats FeederSet::stats(dGeomID geom) const { return impl_->require(geom, "stats").stats; }
+FeederStats FeederSet::stats(dGeomID geom) const {
+  return impl_->require(geom, "stats").stats;
+}
 
-const std::vector<ContactRecord>& FeederSet::records() const { return impl_->records; }
-std::vector<ContactRecord>& FeederSet::records() { return impl_->records; }
+const std::vector<ContactRecord>& FeederSet::records() const {
+  return impl_->records;
+}
+std::vector<ContactRecord>& FeederSet::records() {
+  return impl_->records;
+}
 
 Vec3 FeederSet::slip(const ContactRecord& r) const {
   const Vec3 v_part = pointVelocity(dGeomGetBody(r.part), r.position);
@@ -403,6 +418,8 @@ void FeederSet::setDiagnosticHandler(std::function<void(const Diagnostic&)> hand
   impl_->handler = std::move(handler);
 }
 
-const FeederSet::Options& FeederSet::options() const { return impl_->options; }
+const FeederSet::Options& FeederSet::options() const {
+  return impl_->options;
+}
 
 }  // namespace rheofeed

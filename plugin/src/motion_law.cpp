@@ -137,8 +137,8 @@ MotionLaw MotionLaw::belt(const Vec3& direction, double speed, Frame frame) {
   law.kind_ = Kind::Belt;
   law.frame_ = frame;
   const double length = norm(direction);
-  law.twist_.linear = (length > 0.0 && std::isfinite(length)) ? (1.0 / length) * direction
-                                                                : direction;
+  law.twist_.linear =
+      (length > 0.0 && std::isfinite(length)) ? (1.0 / length) * direction : direction;
   law.belt_speed_ = speed;
   return law;
 }

@@ -42,8 +42,9 @@ class ContactCollider {
     int max_contacts_per_pair = 8;
     /// Skip pairs whose bodies are already connected by a non-contact joint.
     bool skip_connected_bodies = true;
-    /// Attach a dJointFeedback to every feeder contact joint (forces readable after the step
-    /// through FeederSet::records(); needs FeederSet::Options::record_contacts).
+    /// Attach a dJointFeedback to every contact joint: forces readable after the step through
+    /// joints(), and through FeederSet::records() for feeder contacts when the FeederSet has
+    /// Options::record_contacts.
     bool feedback = false;
     /// Surface used when no SurfaceCallback is set: Approx1 friction with mu = 0.5.
     dSurfaceParameters default_surface = {dContactApprox1, 0.5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
@@ -68,8 +69,16 @@ class ContactCollider {
   /// A dNearCallback; `data` must be a ContactCollider*.
   static void nearCallback(void* data, dGeomID o1, dGeomID o2);
 
+  /// A contact joint created since the last clearJoints.
+  struct Joint {
+    dGeomID g1, g2;                      ///< the contact's geoms
+    Vec3 normal;                         ///< unit contact normal (world, from g2 into g1)
+    dJointID joint;                      ///< attached (body(g1), body(g2)) or the reverse
+    dJointFeedback* feedback = nullptr;  ///< forces (N, world) after the step if Settings::feedback
+  };
   /// Contact joints created since the last clearJoints.
-  int contactCount() const { return contact_count_; }
+  int contactCount() const { return static_cast<int>(joints_.size()); }
+  const std::vector<Joint>& joints() const { return joints_; }
   dJointGroupID jointGroup() const { return group_; }
 
  private:
@@ -84,7 +93,7 @@ class ContactCollider {
   std::vector<dContact> buffer_;
   std::deque<dJointFeedback> feedback_;
   std::size_t feedback_used_ = 0;
-  int contact_count_ = 0;
+  std::vector<Joint> joints_;
 };
 
 }  // namespace rheofeed

@@ -67,10 +67,10 @@ enum class AttachOrder {
 
 /// What a diagnostic is about.
 enum class DiagnosticKind {
-  InvalidContact,   ///< non-finite position/normal/depth, or mu NaN or negative: contact removed
-  ZeroFriction,     ///< mu = 0 on a feeder contact: ODE ignores motion1 then (contact kept)
-  LawNotFinite,     ///< the law (profile, twist function or field) gave a non-finite value
-  ForceCapFriction, ///< the contact opted out of dContactApprox1: mu is a force cap (N)
+  InvalidContact,    ///< non-finite position/normal/depth, or mu NaN or negative: contact removed
+  ZeroFriction,      ///< mu = 0 on a feeder contact: ODE ignores motion1 then (contact kept)
+  LawNotFinite,      ///< the law (profile, twist function or field) gave a non-finite value
+  ForceCapFriction,  ///< the contact opted out of dContactApprox1: mu is a force cap (N)
 };
 /// Printable name of a DiagnosticKind ("invalid_contact", ...).
 const char* toString(DiagnosticKind kind);
@@ -85,20 +85,20 @@ struct Diagnostic {
 /// Per-feeder counters. "last step" is the step before the latest beginStep call's step,
 /// i.e. what the latest completed collision pass did.
 struct FeederStats {
-  int contacts_driven = 0;        ///< feeder contacts given fdir1/motion1 (last step)
-  int contacts_undriven = 0;      ///< feeder contacts left with c = 0 (tiny c_rel or bad law)
-  std::uint64_t invalid_contacts = 0;   ///< contacts removed for bad data (all steps)
-  std::uint64_t zero_friction = 0;      ///< contacts with mu = 0 (all steps)
-  std::uint64_t law_not_finite = 0;     ///< contacts left undriven by a non-finite law (all steps)
-  std::uint64_t bodies_woken = 0;       ///< disabled parts woken by a law change (all steps)
+  int contacts_driven = 0;             ///< feeder contacts given fdir1/motion1 (last step)
+  int contacts_undriven = 0;           ///< feeder contacts left with c = 0 (tiny c_rel or bad law)
+  std::uint64_t invalid_contacts = 0;  ///< contacts removed for bad data (all steps)
+  std::uint64_t zero_friction = 0;     ///< contacts with mu = 0 (all steps)
+  std::uint64_t law_not_finite = 0;    ///< contacts left undriven by a non-finite law (all steps)
+  std::uint64_t bodies_woken = 0;      ///< disabled parts woken by a law change (all steps)
 };
 
 /// A driven contact as seen in the last collision pass (recorded on request).
 struct ContactRecord {
-  dGeomID feeder;        ///< the feeder geom (for a feeder-feeder contact: g1)
-  dGeomID part;          ///< the other geom
-  Vec3 position;         ///< contact point (m, world)
-  Vec3 normal;           ///< unit contact normal (world; ODE's: points from g2 into g1)
+  dGeomID feeder;  ///< the feeder geom (for a feeder-feeder contact: g1)
+  dGeomID part;    ///< the other geom
+  Vec3 position;   ///< contact point (m, world)
+  Vec3 normal;     ///< unit contact normal (world; ODE's: points from g2 into g1)
   /// Imposed tangential velocity of the feeder surface relative to the part's own surface:
   /// c_feeder - c_part (m/s, world; c_part = 0 unless the part is a feeder too).
   Vec3 surface_velocity;

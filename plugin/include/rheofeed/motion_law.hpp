@@ -92,8 +92,8 @@ class MotionLaw {
   enum class Kind {
     Twist,          ///< constant twist v + w x (p - O)
     TwistFunction,  ///< twist given as a user function of time
-    Belt,           ///< a belt: speed s along a direction, kept at |s| on any face it is not normal to
-    Field,          ///< a user field c(p, n, t)
+    Belt,   ///< a belt: speed s along a direction, kept at |s| on any face it is not normal to
+    Field,  ///< a user field c(p, n, t)
   };
 
   /// The default law: a stationary surface (zero twist, world frame).

@@ -83,8 +83,8 @@ int rfFeederSetSetBelt(rfFeederSetID set, dGeomID geom, const double direction[3
                        int frame);
 
 /** Scale the feeder's law by a linear ramp from `from` at t_start to `to` at t_end (s). */
-int rfFeederSetSetRamp(rfFeederSetID set, dGeomID geom, double t_start, double t_end,
-                       double from, double to);
+int rfFeederSetSetRamp(rfFeederSetID set, dGeomID geom, double t_start, double t_end, double from,
+                       double to);
 /** Switch the feeder's law on for t_on <= t < t_off (s), off otherwise. */
 int rfFeederSetSetOnOff(rfFeederSetID set, dGeomID geom, double t_on, double t_off);
 

@@ -16,26 +16,44 @@ struct Vec3 {
   double z = 0.0;
 };
 
-inline Vec3 operator+(const Vec3& a, const Vec3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline Vec3 operator-(const Vec3& a, const Vec3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Vec3 operator-(const Vec3& a) { return {-a.x, -a.y, -a.z}; }
-inline Vec3 operator*(double s, const Vec3& a) { return {s * a.x, s * a.y, s * a.z}; }
+inline Vec3 operator+(const Vec3& a, const Vec3& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+inline Vec3 operator-(const Vec3& a, const Vec3& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+inline Vec3 operator-(const Vec3& a) {
+  return {-a.x, -a.y, -a.z};
+}
+inline Vec3 operator*(double s, const Vec3& a) {
+  return {s * a.x, s * a.y, s * a.z};
+}
 inline bool operator==(const Vec3& a, const Vec3& b) {
   return a.x == b.x && a.y == b.y && a.z == b.z;
 }
-inline bool operator!=(const Vec3& a, const Vec3& b) { return !(a == b); }
-inline double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline bool operator!=(const Vec3& a, const Vec3& b) {
+  return !(a == b);
+}
+inline double dot(const Vec3& a, const Vec3& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 inline Vec3 cross(const Vec3& a, const Vec3& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-inline double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
+inline double norm(const Vec3& a) {
+  return std::sqrt(dot(a, a));
+}
 inline bool isFinite(const Vec3& a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }
-inline bool isZero(const Vec3& a) { return a.x == 0.0 && a.y == 0.0 && a.z == 0.0; }
+inline bool isZero(const Vec3& a) {
+  return a.x == 0.0 && a.y == 0.0 && a.z == 0.0;
+}
 
 /// The part of `a` orthogonal to the unit vector `n`: a - (a . n) n.
-inline Vec3 tangentialPart(const Vec3& a, const Vec3& n) { return a - dot(a, n) * n; }
+inline Vec3 tangentialPart(const Vec3& a, const Vec3& n) {
+  return a - dot(a, n) * n;
+}
 
 /// A rigid pose: position (m, world frame) and rotation matrix R (row-major, body to world:
 /// x_world = R x_body + position).

@@ -1,0 +1,153 @@
+// SPDX-License-Identifier: MIT
+/// @file world.hpp
+/// The reference "world": a rigid-body time stepper whose contact dynamics are solved as the
+/// paper's rheonomic cone complementarity problem (true Coulomb cone) by rheofeed::ccp::Solver.
+/// Collision detection is ODE's (dSpaceCollide / dCollide on geoms whose poses this world sets
+/// from its own state), so the reference and an ODE run see the same contacts; ODE's dynamics
+/// are not used. This file is the one adapter between ODE's collision data and the Eigen solver.
+///
+/// ## Time step (semi-implicit Euler, velocity level, as ODE's)
+///   v_free = v + h M^-1 (f_ext + m g) - h I^-1 (w x I w)       (gyroscopic term explicit)
+///   u = D^T v+ + b,  v+ = v_free + M^-1 D gamma,  gamma from the CCP (problem.hpp)
+///   x+ = x + h v+,   q+ = normalise(q + h/2 (0, w+) q)
+///
+/// ## Contacts
+/// For a contact from dCollide(g1, g2): body A carries g1, body B carries g2 (either may be
+/// static or kinematic), n is ODE's normal (from g2 into g1), p the contact point. The contact
+/// velocity is u = (v_A(p) - v_B(p)) in the frame (n, t1, t2), so u_n > 0 separates.
+///
+/// ## Stabilisation: ODE's ERP/CFM semantics, mapped
+///   ODE's contact row asks J v+ >= erp * max(depth - surface_layer, 0) / h, clamped to
+///   max_correcting_velocity, with constraint force mixing cfm on every row. Here:
+///   b_n = -min(erp * max(depth - surface_layer, 0) / h, max_correcting_velocity), and
+///   cfm (in ODE's force units) becomes the impulse-space compliance cfm / h added to the
+///   diagonal of N (ODE solves (J M^-1 J^T + cfm/h) lambda = ..., lambda a force; gamma = h
+///   lambda).
+///
+/// ## Rheonomic term
+///   From the same rheofeed::MotionLaw the ODE plugin uses: with c_A, c_B the tangential surface
+///   velocities of the geoms (0 for a geom that is no feeder), the surfaces stick when
+///   v_A + c_A = v_B + c_B tangentially, so the slip is u_t = D_t^T v - (c_B - c_A).
+#pragma once
+
+#include <ode/ode.h>
+
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rheofeed/ccp/solver.hpp"
+#include "rheofeed/motion_law.hpp"
+#include "rheofeed/vec3.hpp"
+
+namespace rheofeed::reference {
+
+/// Index of a body in a World (0, 1, ...). kStatic means "no body" (the static environment).
+using BodyId = int;
+constexpr BodyId kStatic = -1;
+
+/// Unit quaternion (w, x, y, z), body to world.
+struct Quat {
+  double w = 1, x = 0, y = 0, z = 0;
+};
+
+/// A prescribed motion: pose of the body at time t (s).
+using MotionOfTime = std::function<Pose(double t)>;
+
+/// The state of a body (world frame).
+struct BodyState {
+  Vec3 position;          ///< centre of mass (m)
+  Quat orientation;       ///< body to world
+  Vec3 linear_velocity;   ///< of the centre of mass (m/s)
+  Vec3 angular_velocity;  ///< (rad/s)
+};
+
+/// Contact impulse of the last step, in the world frame.
+struct ContactImpulse {
+  dGeomID g1 = nullptr, g2 = nullptr;
+  BodyId body1 = kStatic, body2 = kStatic;
+  Vec3 position;               ///< (m)
+  Vec3 normal;                 ///< unit, from g2 into g1
+  double depth = 0;            ///< (m)
+  double normal_impulse = 0;   ///< gamma_n (N s), on body1 along +normal
+  Vec3 tangential_impulse;     ///< friction impulse on body1 (N s)
+  Vec3 slip;                   ///< u_t after the step (m/s): v_1 - v_2 - (c_2 - c_1), tangential
+  double normal_velocity = 0;  ///< u_n after the step (m/s), > 0 separating
+};
+
+/// Settings of the reference world, with ODE's defaults where ODE has one.
+struct Settings {
+  Vec3 gravity{0, 0, -9.81};  ///< (m/s^2)
+  double erp = 0.2;           ///< as dWorldSetERP (dimensionless, 0..1)
+  double cfm = 1e-5;          ///< as dWorldSetCFM (ODE's force units, >= 0)
+  double max_correcting_velocity = std::numeric_limits<double>::infinity();  ///< (m/s)
+  double surface_layer = 0.0;     ///< as dWorldSetContactSurfaceLayer (m)
+  int max_contacts_per_pair = 8;  ///< contacts asked of dCollide per pair
+  double default_mu = 0.5;        ///< friction coefficient when no callback is set
+  bool warm_start = true;         ///< reuse last step's impulses per (pair, index)
+  ccp::Settings solver;           ///< the CCP solver's settings
+  /// Use the dense Delassus matrix up to this many contacts, matrix-free above.
+  int dense_contact_limit = 100;
+};
+
+/// Friction coefficient for a pair of geoms (dimensionless, >= 0).
+using FrictionCallback = std::function<double(dGeomID g1, dGeomID g2)>;
+
+/// What one step did.
+struct StepReport {
+  int contacts = 0;
+  ccp::Result solve;  ///< the solver's result (status, iterations, residuals, time)
+};
+
+/// The reference world. Geoms are created by the caller in space() without ODE bodies and then
+/// attached with attachGeom; static geoms are left unattached.
+class World {
+ public:
+  /// Throws std::invalid_argument naming a bad setting.
+  explicit World(const Settings& settings = {});
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  /// The ODE space holding every geom of this world (owned by the world).
+  dSpaceID space() const;
+
+  /// A dynamic body of mass `mass` (kg) with inertia tensor `inertia` (kg m^2, row-major 3x3,
+  /// body frame, about the centre of mass) at `state`. Throws on a non-positive mass,
+  /// non-finite values or an inertia that is not symmetric positive definite.
+  BodyId addBody(double mass, const double inertia[9], const BodyState& state);
+  /// A body that follows `motion` exactly (infinite mass). Its velocity over a step is the
+  /// secant of the motion, as for an ODE kinematic body driven with secant velocities.
+  BodyId addKinematicBody(MotionOfTime motion);
+  /// Attach a geom of space() to a body with an offset pose (body frame). Throws if the geom
+  /// has an ODE body, is not in space(), is already attached, or the body does not exist.
+  void attachGeom(dGeomID geom, BodyId body, const Pose& offset = {});
+
+  /// Make `geom` a feeder with `law` (the plugin's law type; Frame::Body follows the body the
+  /// geom is attached to). Throws on an invalid law (names the value).
+  void setFeeder(dGeomID geom, MotionLaw law);
+  /// Per-pair friction coefficient (default: Settings::default_mu everywhere).
+  void setFrictionCallback(FrictionCallback callback);
+  /// External force (N) and torque (N m) on a body for the next step only (world frame).
+  void addForce(BodyId body, const Vec3& force, const Vec3& torque = {});
+
+  /// Advance by h (s). Throws std::invalid_argument if h is not finite and > 0. A solver that
+  /// does not converge is reported in the StepReport (status), not thrown.
+  StepReport step(double h);
+
+  double time() const;
+  int numBodies() const;
+  const BodyState& state(BodyId body) const;
+  double mass(BodyId body) const;  ///< (kg); infinity for a kinematic body
+  /// Contacts of the last step with their impulses.
+  const std::vector<ContactImpulse>& contacts() const;
+  Settings& settings();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rheofeed::reference

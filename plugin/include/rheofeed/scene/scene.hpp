@@ -1,0 +1,180 @@
+// SPDX-License-Identifier: MIT
+/// @file scene.hpp
+/// One scene description that drives every method: ODE + plugin (rheonomic), ODE full
+/// vibration, the reference solver rheonomic, the reference solver full vibration.
+///
+/// A scene is fixtures (static geometry, some of them feeders with a motion law), parts (shapes
+/// drawn from size distributions, spawned at t = 0 or at a flow rate), one material, solver
+/// settings and a duration. Units: SI (m, s, kg, m/s, rad/s, Hz); vectors in the world frame;
+/// gravity along -z unless the scene says otherwise.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "rheofeed/motion_law.hpp"
+#include "rheofeed/vec3.hpp"
+
+namespace rheofeed::scene {
+
+/// A collision shape. Sizes in metres; cylinders and capsules lie along their local z axis.
+struct Shape {
+  enum class Kind { Box, Sphere, Cylinder, Capsule, Plane, Mesh };
+  Kind kind = Kind::Box;
+  Vec3 size{0.1, 0.1, 0.1};  ///< Box: edge lengths (m)
+  double radius = 0.05;      ///< Sphere, Cylinder, Capsule (m)
+  double length = 0.1;       ///< Cylinder, Capsule: length along local z (m)
+  /// Plane: unit normal (world) and offset d (m): points p with normal . p = d. Static only.
+  Vec3 plane_normal{0, 0, 1};
+  double plane_offset = 0;
+  std::string mesh;         ///< Mesh: file path (any format assimp reads)
+  double mesh_scale = 1.0;  ///< Mesh: scale applied to the file's coordinates
+};
+
+/// Printable name of a shape kind ("box", "sphere", ...).
+const char* toString(Shape::Kind kind);
+
+/// A real vibration of a feeder (the conventional method): the feeder's kinematic body moves as
+///   x(t) = amplitude sin(2 pi frequency t + phase) direction            (m)
+///   theta(t) = torsion_amplitude sin(2 pi frequency t + phase)          (rad, about the axis)
+/// A screw motion (bowl feeders) has both: vertical translation along the axis and torsion.
+struct Vibration {
+  double amplitude = 0;          ///< peak displacement (m), not peak-to-peak
+  double frequency = 0;          ///< (Hz)
+  Vec3 direction{1, 0, 0};       ///< unit translation direction (world)
+  double phase = 0;              ///< (rad)
+  double torsion_amplitude = 0;  ///< peak rotation about the axis (rad)
+  Vec3 axis_origin{0, 0, 0};     ///< a point of the torsion axis (m)
+  Vec3 axis_direction{0, 0, 1};  ///< unit torsion axis
+  /// Pose of the vibrating feeder at time t relative to its rest pose (apply to the rest pose).
+  Pose displacement(double t) const;
+  bool isZero() const { return amplitude == 0 && torsion_amplitude == 0; }
+};
+
+/// How a feeder moves.
+struct FeederLaw {
+  enum class Kind {
+    None,       ///< not a feeder: plain static geometry
+    Drift,      ///< a drift field: rheonomic twist, the homogenised transport velocity itself
+    Belt,       ///< a belt of speed `belt_speed` along `belt_direction`
+    Vibration,  ///< a real vibration; rheonomic methods use its calibrated drift field
+  };
+  Kind kind = Kind::None;
+  Twist drift;  ///< Drift: v (m/s), w (rad/s) about origin (m), world frame
+  Vec3 belt_direction{1, 0, 0};
+  double belt_speed = 0;  ///< (m/s)
+  Vibration vibration;    ///< Vibration
+  /// Vibration: the drift field that replaces it in rheonomic runs (from calibration). Set by
+  /// the calibration step or given by the scene ("vibration, calibrated").
+  bool has_calibrated_drift = false;
+  Twist calibrated_drift;
+};
+
+/// A fixture: static geometry, optionally a feeder. All its geoms move together in a full
+/// vibration run.
+struct Fixture {
+  std::string name;
+  struct Geom {
+    Shape shape;
+    Pose pose;  ///< pose of the geom in the world (at rest)
+  };
+  std::vector<Geom> geoms;
+  FeederLaw law;
+};
+
+/// A normally distributed size, truncated to [min, max] (m).
+struct Distribution {
+  double mean = 0.01;
+  double stddev = 0;
+  double min = 0;
+  double max = 1e300;
+};
+
+/// A family of parts.
+struct PartSpec {
+  std::string name = "parts";
+  Shape::Kind shape = Shape::Kind::Box;
+  Distribution size[3];  ///< Box: x, y, z edges; Sphere: [0] radius; Cyl/Capsule: [0] r, [1] length
+  std::string mesh;      ///< Mesh parts: file (assimp); size[0] scales it
+  double density = 7800;      ///< (kg/m^3)
+  Vec3 spawn_min, spawn_max;  ///< spawn region, axis-aligned box (m, world)
+  bool random_orientation = false;
+  int count = 1;          ///< total number of parts
+  double rate = 0;        ///< parts per second; 0: all at t = 0
+  Vec3 initial_velocity;  ///< (m/s)
+};
+
+/// Contact material (one for all pairs).
+struct Material {
+  double mu = 0.5;           ///< friction coefficient (>= 0)
+  double restitution = 0.0;  ///< (0..1)
+};
+
+/// The dynamics engine and its settings.
+struct SolverSettings {
+  double time_step = 0.01;    ///< (s)
+  int iterations = 50;        ///< ODE quickstep iterations or CCP iteration budget
+  bool ode_quickstep = true;  ///< ODE: dWorldQuickStep (true) or dWorldStep (Dantzig)
+  double erp = 0.2;           ///< ODE and reference
+  double cfm = 1e-5;          ///< ODE and reference (ODE's units)
+  double tolerance = 1e-6;    ///< CCP residual tolerance
+  bool apgd = true;           ///< CCP: APGD (true) or PGS
+};
+
+/// The four methods.
+enum class Method {
+  OdeRheonomic,            ///< ODE + plugin, stationary feeders
+  OdeFullVibration,        ///< ODE, feeders on kinematic bodies that really vibrate
+  ReferenceRheonomic,      ///< reference CCP solver, stationary feeders
+  ReferenceFullVibration,  ///< reference CCP solver, vibrating feeders
+};
+const char* toString(Method method);
+bool isFullVibration(Method method);
+
+/// What to measure.
+struct Outputs {
+  Vec3 conveying_direction{1, 0, 0};  ///< unit direction of the drift metric
+  bool exit_plane = false;            ///< count parts crossing the plane
+  Vec3 exit_point, exit_normal{1, 0, 0};
+  double sample_interval = 0.01;  ///< (s) metric sampling period
+  double warmup = 0.0;            ///< (s) excluded from the mean drift
+};
+
+struct Scene {
+  std::string name = "scene";
+  Vec3 gravity{0, 0, -9.81};
+  std::vector<Fixture> fixtures;
+  std::vector<PartSpec> parts;
+  Material material;
+  SolverSettings solver;
+  double duration = 1.0;  ///< (s)
+  std::uint64_t seed = 1;
+  Outputs outputs;
+
+  /// Throws std::invalid_argument naming the path of the first bad value
+  /// (e.g. "parts[0].size[1].mean = -1: must be > 0").
+  void validate() const;
+  bool hasMeshes() const;
+  bool hasVibration() const;
+};
+
+/// The motion law a rheonomic method uses for a fixture (None -> not a feeder). Throws if a
+/// vibrating fixture has no calibrated drift.
+MotionLaw rheonomicLaw(const Fixture& fixture);
+
+/// One part instance, drawn from a PartSpec (deterministic from the scene seed).
+struct PartInstance {
+  int spec = 0;
+  Shape shape;
+  double mass = 0;         ///< (kg)
+  double inertia[9] = {};  ///< body frame, about the centre of mass (kg m^2)
+  Pose pose;
+  Vec3 velocity;
+  double spawn_time = 0;  ///< (s)
+};
+
+/// All parts of the scene in spawn order (mesh parts get their inertia from the mesh).
+std::vector<PartInstance> drawParts(const Scene& scene);
+
+}  // namespace rheofeed::scene

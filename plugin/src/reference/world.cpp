@@ -1,0 +1,531 @@
+// SPDX-License-Identifier: MIT
+// The reference world: ODE collision in, Eigen cone complementarity out (see world.hpp).
+#include "rheofeed/reference/world.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <Eigen/SparseCore>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <tuple>
+#include <unordered_map>
+#include <utility>
+
+#include "rheofeed/ccp/problem.hpp"
+
+namespace rheofeed::reference {
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+Vector3d toEigen(const Vec3& v) {
+  return {v.x, v.y, v.z};
+}
+Vec3 toVec3(const Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+Vec3 toVec3(const dReal* a) {
+  return {a[0], a[1], a[2]};
+}
+Eigen::Quaterniond toEigen(const Quat& q) {
+  return {q.w, q.x, q.y, q.z};
+}
+Quat toQuat(const Eigen::Quaterniond& q) {
+  return {q.w(), q.x(), q.y(), q.z()};
+}
+
+Matrix3d rotationOf(const Pose& p) {
+  Matrix3d r;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) r(i, j) = p.rotation[3 * i + j];
+  }
+  return r;
+}
+
+Pose poseOf(const Vector3d& x, const Matrix3d& r) {
+  Pose p;
+  p.position = toVec3(x);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) p.rotation[3 * i + j] = r(i, j);
+  }
+  return p;
+}
+
+// Two unit vectors completing the unit normal n to a right-handed frame (as ODE's dPlaneSpace).
+void planeSpace(const Vector3d& n, Vector3d& t1, Vector3d& t2) {
+  if (std::abs(n.z()) > M_SQRT1_2) {
+    const double a = n.y() * n.y() + n.z() * n.z(), k = 1.0 / std::sqrt(a);
+    t1 = {0, -n.z() * k, n.y() * k};
+  } else {
+    const double a = n.x() * n.x() + n.y() * n.y(), k = 1.0 / std::sqrt(a);
+    t1 = {-n.y() * k, n.x() * k, 0};
+  }
+  t2 = n.cross(t1);
+}
+
+[[noreturn]] void refuse(const std::string& message) {
+  throw std::invalid_argument("rheofeed::reference::World: " + message);
+}
+
+// Below this surface speed (m/s) the friction frame is ODE's plane space, not aligned with c.
+constexpr double kMinSurfaceSpeed = 1e-12;
+
+}  // namespace
+
+struct World::Impl {
+  struct Body {
+    bool kinematic = false;
+    double mass = 0;
+    Matrix3d inv_inertia_body = Matrix3d::Zero();
+    Matrix3d inertia_body = Matrix3d::Zero();
+    BodyState state;
+    MotionOfTime motion;
+    int dof = -1;  // first generalised velocity index (dynamic bodies only)
+    Vector3d force = Vector3d::Zero(), torque = Vector3d::Zero();
+  };
+  struct Attached {
+    BodyId body;
+    Pose offset;
+  };
+  struct Feeder {
+    MotionLaw law;
+    StepLaw frozen;
+  };
+  struct RawContact {
+    dGeomID g1, g2;
+    BodyId a, b;
+    Vector3d p, n;
+    double depth, mu;
+    int index;  // position among the pair's contacts (warm start key)
+  };
+
+  Settings settings;
+  dSpaceID space = nullptr;
+  double time = 0;
+  std::vector<Body> bodies;
+  std::unordered_map<dGeomID, Attached> attached;
+  std::unordered_map<dGeomID, Feeder> feeders;
+  FrictionCallback friction;
+  ccp::Solver solver;
+  std::vector<RawContact> raw;
+  std::vector<ContactImpulse> contacts;
+  std::map<std::tuple<dGeomID, dGeomID, int>, Vector3d> warm;
+  std::vector<dContactGeom> scratch;
+
+  BodyId bodyOf(dGeomID g) const {
+    auto it = attached.find(g);
+    return it == attached.end() ? kStatic : it->second.body;
+  }
+  bool isDynamic(BodyId b) const { return b != kStatic && !bodies[b].kinematic; }
+
+  Matrix3d rotation(BodyId b) const {
+    return toEigen(bodies[b].state.orientation).normalized().toRotationMatrix();
+  }
+
+  // Velocity (m/s, world) of body b's material point at p (0 for the static environment).
+  Vector3d pointVelocity(BodyId b, const Vector3d& p, const Eigen::VectorXd& v) const {
+    if (b == kStatic) return Vector3d::Zero();
+    const Body& body = bodies[b];
+    const Vector3d x = toEigen(body.state.position);
+    if (body.kinematic) {
+      return toEigen(body.state.linear_velocity) +
+             toEigen(body.state.angular_velocity).cross(p - x);
+    }
+    return v.segment<3>(body.dof) + v.segment<3>(body.dof + 3).cross(p - x);
+  }
+
+  void placeGeoms() {
+    for (auto& [geom, a] : attached) {
+      const Body& body = bodies[a.body];
+      const Matrix3d rb = rotation(a.body);
+      const Matrix3d r = rb * rotationOf(a.offset);
+      const Vector3d x = toEigen(body.state.position) + rb * toEigen(a.offset.position);
+      dGeomSetPosition(geom, x.x(), x.y(), x.z());
+      dMatrix3 m;
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) m[4 * i + j] = r(i, j);
+        m[4 * i + 3] = 0;
+      }
+      dGeomSetRotation(geom, m);
+    }
+  }
+
+  static void nearCallback(void* data, dGeomID o1, dGeomID o2) {
+    auto* self = static_cast<Impl*>(data);
+    if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) {
+      dSpaceCollide2(o1, o2, data, &nearCallback);
+      return;
+    }
+    const BodyId a = self->bodyOf(o1), b = self->bodyOf(o2);
+    if (!self->isDynamic(a) && !self->isDynamic(b)) return;
+    if (a == b) return;
+    const int max = self->settings.max_contacts_per_pair;
+    self->scratch.resize(static_cast<std::size_t>(max));
+    const int n = dCollide(o1, o2, max, self->scratch.data(), sizeof(dContactGeom));
+    if (n <= 0) return;
+    const double mu = self->friction ? self->friction(o1, o2) : self->settings.default_mu;
+    for (int i = 0; i < n; ++i) {
+      const dContactGeom& c = self->scratch[static_cast<std::size_t>(i)];
+      self->raw.push_back({c.g1, c.g2, self->bodyOf(c.g1), self->bodyOf(c.g2),
+                           toEigen(toVec3(c.pos)), toEigen(toVec3(c.normal)), c.depth, mu, i});
+    }
+  }
+
+  // Tangential surface velocity of geom g at p with normal n (0 if g is no feeder).
+  Vector3d surfaceVelocity(dGeomID g, const Vector3d& p, const Vector3d& n) const {
+    auto it = feeders.find(g);
+    if (it == feeders.end()) return Vector3d::Zero();
+    return toEigen(it->second.frozen.tangentialVelocity(toVec3(p), toVec3(n)));
+  }
+
+  void freezeLaws() {
+    for (auto& [geom, f] : feeders) {
+      Pose pose;
+      const Pose* body_pose = nullptr;
+      const BodyId b = bodyOf(geom);
+      if (b != kStatic) {
+        pose = poseOf(toEigen(bodies[b].state.position), rotation(b));
+        body_pose = &pose;
+      }
+      f.frozen = f.law.evaluate(time, body_pose);
+      if (!f.frozen.finite()) refuse("feeder law is not finite: " + f.frozen.problem());
+    }
+  }
+};
+
+World::World(const Settings& settings) : impl_(std::make_unique<Impl>()) {
+  std::ostringstream bad;
+  if (!(settings.erp >= 0 && settings.erp <= 1))
+    bad << "Settings::erp = " << settings.erp << " must be in [0, 1]";
+  else if (!(settings.cfm >= 0) || !std::isfinite(settings.cfm))
+    bad << "Settings::cfm = " << settings.cfm << " must be finite and >= 0";
+  else if (!(settings.max_correcting_velocity >= 0))
+    bad << "Settings::max_correcting_velocity = " << settings.max_correcting_velocity
+        << " must be >= 0";
+  else if (!(settings.surface_layer >= 0) || !std::isfinite(settings.surface_layer))
+    bad << "Settings::surface_layer = " << settings.surface_layer << " must be finite and >= 0";
+  else if (settings.max_contacts_per_pair < 1)
+    bad << "Settings::max_contacts_per_pair = " << settings.max_contacts_per_pair
+        << " must be >= 1";
+  else if (!(settings.default_mu >= 0) || !std::isfinite(settings.default_mu))
+    bad << "Settings::default_mu = " << settings.default_mu << " must be finite and >= 0";
+  else if (!isFinite(settings.gravity))
+    bad << "Settings::gravity is not finite";
+  else if (std::string m = settings.solver.validate(); !m.empty())
+    bad << "Settings::solver: " << m;
+  if (!bad.str().empty()) refuse(bad.str());
+  impl_->settings = settings;
+  impl_->solver.settings() = settings.solver;
+  impl_->space = dHashSpaceCreate(nullptr);
+}
+
+World::~World() {
+  if (impl_ && impl_->space) dSpaceDestroy(impl_->space);
+}
+
+dSpaceID World::space() const {
+  return impl_->space;
+}
+
+BodyId World::addBody(double mass, const double inertia[9], const BodyState& state) {
+  if (!(mass > 0) || !std::isfinite(mass)) {
+    std::ostringstream out;
+    out << "addBody: mass = " << mass << " must be finite and > 0 (kg)";
+    refuse(out.str());
+  }
+  Matrix3d i;
+  for (int k = 0; k < 9; ++k) {
+    if (!std::isfinite(inertia[k]))
+      refuse("addBody: inertia[" + std::to_string(k) + "] is not finite");
+    i(k / 3, k % 3) = inertia[k];
+  }
+  if ((i - i.transpose()).norm() > 1e-12 * i.norm()) refuse("addBody: inertia is not symmetric");
+  Eigen::SelfAdjointEigenSolver<Matrix3d> eig(i);
+  if (eig.eigenvalues().minCoeff() <= 0) {
+    std::ostringstream out;
+    out << "addBody: inertia has eigenvalue " << eig.eigenvalues().minCoeff()
+        << " <= 0 (must be positive definite, kg m^2)";
+    refuse(out.str());
+  }
+  if (!isFinite(state.position) || !isFinite(state.linear_velocity) ||
+      !isFinite(state.angular_velocity)) {
+    refuse("addBody: initial state is not finite");
+  }
+  Impl::Body b;
+  b.mass = mass;
+  b.inertia_body = i;
+  b.inv_inertia_body = i.inverse();
+  b.state = state;
+  b.state.orientation = toQuat(toEigen(state.orientation).normalized());
+  int dof = 0;
+  for (const auto& other : impl_->bodies) dof += other.kinematic ? 0 : 6;
+  b.dof = dof;
+  impl_->bodies.push_back(b);
+  return static_cast<BodyId>(impl_->bodies.size() - 1);
+}
+
+BodyId World::addKinematicBody(MotionOfTime motion) {
+  if (!motion) refuse("addKinematicBody: motion function is empty");
+  Impl::Body b;
+  b.kinematic = true;
+  b.mass = std::numeric_limits<double>::infinity();
+  b.motion = std::move(motion);
+  const Pose p = b.motion(impl_->time);
+  if (!isFinite(p.position)) refuse("addKinematicBody: motion(t) position is not finite");
+  b.state.position = p.position;
+  b.state.orientation = toQuat(Eigen::Quaterniond(rotationOf(p)).normalized());
+  impl_->bodies.push_back(std::move(b));
+  return static_cast<BodyId>(impl_->bodies.size() - 1);
+}
+
+void World::attachGeom(dGeomID geom, BodyId body, const Pose& offset) {
+  if (!geom) refuse("attachGeom: geom is null");
+  if (body < 0 || body >= numBodies())
+    refuse("attachGeom: body " + std::to_string(body) + " does not exist");
+  if (dGeomGetBody(geom))
+    refuse("attachGeom: geom has an ODE body; reference geoms must have none");
+  if (dGeomGetSpace(geom) != impl_->space) refuse("attachGeom: geom is not in World::space()");
+  if (impl_->attached.count(geom)) refuse("attachGeom: geom is already attached");
+  if (!isFinite(offset.position)) refuse("attachGeom: offset position is not finite");
+  impl_->attached.emplace(geom, Impl::Attached{body, offset});
+}
+
+void World::setFeeder(dGeomID geom, MotionLaw law) {
+  if (!geom) refuse("setFeeder: geom is null");
+  std::ostringstream where;
+  where << "rheofeed::reference::World::setFeeder: geom " << static_cast<const void*>(geom);
+  law.validate(where.str());
+  impl_->feeders[geom] = Impl::Feeder{std::move(law), StepLaw{}};
+}
+
+void World::setFrictionCallback(FrictionCallback callback) {
+  impl_->friction = std::move(callback);
+}
+
+void World::addForce(BodyId body, const Vec3& force, const Vec3& torque) {
+  if (body < 0 || body >= numBodies())
+    refuse("addForce: body " + std::to_string(body) + " does not exist");
+  if (!isFinite(force) || !isFinite(torque)) refuse("addForce: force or torque is not finite");
+  impl_->bodies[body].force += toEigen(force);
+  impl_->bodies[body].torque += toEigen(torque);
+}
+
+StepReport World::step(double h) {
+  Impl& s = *impl_;
+  if (!(h > 0) || !std::isfinite(h)) {
+    std::ostringstream out;
+    out << "step: h = " << h << " must be finite and > 0 (s)";
+    refuse(out.str());
+  }
+  const Settings& cfg = s.settings;
+
+  // Kinematic bodies: secant velocity over [t, t + h], pose at t + h applied after the step.
+  std::vector<Pose> next_pose(s.bodies.size());
+  for (std::size_t k = 0; k < s.bodies.size(); ++k) {
+    Impl::Body& b = s.bodies[k];
+    if (!b.kinematic) continue;
+    const Pose p0 = b.motion(s.time), p1 = b.motion(s.time + h);
+    if (!isFinite(p0.position) || !isFinite(p1.position)) refuse("kinematic motion is not finite");
+    const Matrix3d r0 = rotationOf(p0), r1 = rotationOf(p1);
+    const Eigen::AngleAxisd rel(r1 * r0.transpose());
+    b.state.position = p0.position;
+    b.state.orientation = toQuat(Eigen::Quaterniond(r0).normalized());
+    b.state.linear_velocity = (1.0 / h) * (p1.position - p0.position);
+    b.state.angular_velocity = toVec3(rel.axis() * (rel.angle() / h));
+    next_pose[k] = p1;
+  }
+
+  s.placeGeoms();
+  s.freezeLaws();
+  s.raw.clear();
+  dSpaceCollide(s.space, &s, &Impl::nearCallback);
+
+  // Free velocities of the dynamic bodies.
+  int ndof = 0;
+  for (const auto& b : s.bodies) ndof += b.kinematic ? 0 : 6;
+  Eigen::VectorXd v_free(ndof);
+  std::vector<Matrix3d> inv_inertia_world(s.bodies.size(), Matrix3d::Zero());
+  for (std::size_t k = 0; k < s.bodies.size(); ++k) {
+    Impl::Body& b = s.bodies[k];
+    if (b.kinematic) continue;
+    const Matrix3d r = s.rotation(static_cast<BodyId>(k));
+    const Matrix3d i_world = r * b.inertia_body * r.transpose();
+    inv_inertia_world[k] = r * b.inv_inertia_body * r.transpose();
+    const Vector3d w = toEigen(b.state.angular_velocity);
+    v_free.segment<3>(b.dof) =
+        toEigen(b.state.linear_velocity) + h * (toEigen(cfg.gravity) + b.force / b.mass);
+    v_free.segment<3>(b.dof + 3) = w + h * inv_inertia_world[k] * (b.torque - w.cross(i_world * w));
+  }
+
+  const int nc = static_cast<int>(s.raw.size());
+  StepReport report;
+  report.contacts = nc;
+  Eigen::VectorXd v_next = v_free;
+  std::vector<ContactImpulse> out(static_cast<std::size_t>(nc));
+  if (nc > 0) {
+    std::vector<Eigen::Triplet<double>> d_entries;
+    d_entries.reserve(static_cast<std::size_t>(nc) * 3 * 12);
+    Eigen::VectorXd r(3 * nc), mu(nc);
+    std::vector<Matrix3d> frames(static_cast<std::size_t>(nc));  // columns n, t1, t2
+    for (int i = 0; i < nc; ++i) {
+      const Impl::RawContact& c = s.raw[static_cast<std::size_t>(i)];
+      const Vector3d c_rel = s.surfaceVelocity(c.g2, c.p, c.n) - s.surfaceVelocity(c.g1, c.p, c.n);
+      const Vector3d c_t = c_rel - c_rel.dot(c.n) * c.n;
+      Vector3d t1, t2;
+      const double speed = c_t.norm();
+      if (speed > kMinSurfaceSpeed) {
+        t1 = c_t / speed;
+        t2 = c.n.cross(t1);
+      } else {
+        planeSpace(c.n, t1, t2);
+      }
+      Matrix3d& f = frames[static_cast<std::size_t>(i)];
+      f.col(0) = c.n;
+      f.col(1) = t1;
+      f.col(2) = t2;
+      const Vector3d rel_free =
+          s.pointVelocity(c.a, c.p, v_free) - s.pointVelocity(c.b, c.p, v_free);
+      const double push = std::min(cfg.erp * std::max(c.depth - cfg.surface_layer, 0.0) / h,
+                                   cfg.max_correcting_velocity);
+      r(3 * i) = c.n.dot(rel_free) - push;
+      r(3 * i + 1) = t1.dot(rel_free) - t1.dot(c_t);
+      r(3 * i + 2) = t2.dot(rel_free) - t2.dot(c_t);
+      mu(i) = c.mu;
+      for (int k = 0; k < 3; ++k) {
+        const Vector3d dir = f.col(k);
+        for (int side = 0; side < 2; ++side) {
+          const BodyId b = side == 0 ? c.a : c.b;
+          if (!s.isDynamic(b)) continue;
+          const double sign = side == 0 ? 1.0 : -1.0;
+          const Vector3d arm = c.p - toEigen(s.bodies[b].state.position);
+          const Vector3d ang = arm.cross(dir);
+          const int dof = s.bodies[b].dof;
+          for (int q = 0; q < 3; ++q) {
+            d_entries.emplace_back(dof + q, 3 * i + k, sign * dir(q));
+            d_entries.emplace_back(dof + 3 + q, 3 * i + k, sign * ang(q));
+          }
+        }
+      }
+    }
+    ccp::SparseMatrix d(ndof, 3 * nc);
+    d.setFromTriplets(d_entries.begin(), d_entries.end());
+    std::vector<Eigen::Triplet<double>> m_entries;
+    m_entries.reserve(static_cast<std::size_t>(ndof) * 3);
+    for (std::size_t k = 0; k < s.bodies.size(); ++k) {
+      const Impl::Body& b = s.bodies[k];
+      if (b.kinematic) continue;
+      for (int q = 0; q < 3; ++q) m_entries.emplace_back(b.dof + q, b.dof + q, 1.0 / b.mass);
+      for (int p = 0; p < 3; ++p) {
+        for (int q = 0; q < 3; ++q) {
+          m_entries.emplace_back(b.dof + 3 + p, b.dof + 3 + q, inv_inertia_world[k](p, q));
+        }
+      }
+    }
+    ccp::SparseMatrix minv(ndof, ndof);
+    minv.setFromTriplets(m_entries.begin(), m_entries.end());
+
+    const double compliance = cfg.cfm / h;
+    ccp::Problem problem;
+    if (nc <= cfg.dense_contact_limit) {
+      Eigen::MatrixXd n = Eigen::MatrixXd(d.transpose() * (minv * d));
+      n.diagonal().array() += compliance;
+      problem = ccp::Problem::makeDense(std::move(n), r, mu);
+    } else {
+      problem = ccp::Problem::makeMatrixFree(d, minv, r, mu);
+      // COMPLIANCE-PENDING problem.compliance = compliance;
+    }
+
+    Eigen::VectorXd gamma = Eigen::VectorXd::Zero(3 * nc);
+    if (cfg.warm_start) {
+      for (int i = 0; i < nc; ++i) {
+        const Impl::RawContact& c = s.raw[static_cast<std::size_t>(i)];
+        auto it = s.warm.find({c.g1, c.g2, c.index});
+        if (it != s.warm.end()) gamma.segment<3>(3 * i) = it->second;
+      }
+    }
+    report.solve = s.solver.solve(problem, gamma);
+    if (report.solve.status == ccp::Status::InvalidInput) {
+      refuse("step: the contact problem was refused: " + report.solve.message);
+    }
+    v_next = v_free + minv * (d * gamma);
+    const Eigen::VectorXd u = d.transpose() * v_next + (r - d.transpose() * v_free);
+
+    s.warm.clear();
+    for (int i = 0; i < nc; ++i) {
+      const Impl::RawContact& c = s.raw[static_cast<std::size_t>(i)];
+      const Matrix3d& f = frames[static_cast<std::size_t>(i)];
+      s.warm[{c.g1, c.g2, c.index}] = gamma.segment<3>(3 * i);
+      ContactImpulse& ci = out[static_cast<std::size_t>(i)];
+      ci.g1 = c.g1;
+      ci.g2 = c.g2;
+      ci.body1 = c.a;
+      ci.body2 = c.b;
+      ci.position = toVec3(c.p);
+      ci.normal = toVec3(c.n);
+      ci.depth = c.depth;
+      ci.normal_impulse = gamma(3 * i);
+      ci.tangential_impulse = toVec3(gamma(3 * i + 1) * f.col(1) + gamma(3 * i + 2) * f.col(2));
+      ci.slip = toVec3(u(3 * i + 1) * f.col(1) + u(3 * i + 2) * f.col(2));
+      ci.normal_velocity = u(3 * i);
+    }
+  } else {
+    s.warm.clear();
+  }
+  s.contacts = std::move(out);
+
+  // Integrate (semi-implicit Euler, as ODE's dxStepBody without finite rotation).
+  for (std::size_t k = 0; k < s.bodies.size(); ++k) {
+    Impl::Body& b = s.bodies[k];
+    if (b.kinematic) {
+      b.state.position = next_pose[k].position;
+      b.state.orientation = toQuat(Eigen::Quaterniond(rotationOf(next_pose[k])).normalized());
+      continue;
+    }
+    const Vector3d v = v_next.segment<3>(b.dof), w = v_next.segment<3>(b.dof + 3);
+    b.state.linear_velocity = toVec3(v);
+    b.state.angular_velocity = toVec3(w);
+    b.state.position = toVec3(toEigen(b.state.position) + h * v);
+    Eigen::Quaterniond q = toEigen(b.state.orientation);
+    const Eigen::Quaterniond wq(0, w.x(), w.y(), w.z());
+    Eigen::Quaterniond dq = wq * q;
+    q.coeffs() += 0.5 * h * dq.coeffs();
+    b.state.orientation = toQuat(q.normalized());
+    b.force.setZero();
+    b.torque.setZero();
+    if (!isFinite(b.state.position) || !isFinite(b.state.linear_velocity)) {
+      refuse("step: body " + std::to_string(k) + " state became non-finite (solver status " +
+             ccp::toString(report.solve.status) + ")");
+    }
+  }
+  s.time += h;
+  return report;
+}
+
+double World::time() const {
+  return impl_->time;
+}
+int World::numBodies() const {
+  return static_cast<int>(impl_->bodies.size());
+}
+const BodyState& World::state(BodyId body) const {
+  if (body < 0 || body >= numBodies())
+    refuse("state: body " + std::to_string(body) + " does not exist");
+  return impl_->bodies[body].state;
+}
+double World::mass(BodyId body) const {
+  if (body < 0 || body >= numBodies())
+    refuse("mass: body " + std::to_string(body) + " does not exist");
+  return impl_->bodies[body].mass;
+}
+const std::vector<ContactImpulse>& World::contacts() const {
+  return impl_->contacts;
+}
+Settings& World::settings() {
+  return impl_->settings;
+}
+
+}  // namespace rheofeed::reference

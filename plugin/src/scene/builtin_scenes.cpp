@@ -1,0 +1,170 @@
+// SPDX-License-Identifier: MIT
+#include "rheofeed/scene/builtin_scenes.hpp"
+
+#include <cmath>
+
+namespace rheofeed::scene {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Rotation about unit axis k by angle a (row-major, body to world).
+Pose rotated(const Vec3& k, double a, const Vec3& position) {
+  const double c = std::cos(a), s = std::sin(a), v = 1 - c;
+  Pose p;
+  const double r[9] = {c + k.x * k.x * v,       k.x * k.y * v - k.z * s, k.x * k.z * v + k.y * s,
+                       k.y * k.x * v + k.z * s, c + k.y * k.y * v,       k.y * k.z * v - k.x * s,
+                       k.z * k.x * v - k.y * s, k.z * k.y * v + k.x * s, c + k.z * k.z * v};
+  for (int i = 0; i < 9; ++i) p.rotation[i] = r[i];
+  p.position = position;
+  return p;
+}
+
+Fixture boxFixture(const std::string& name, const Vec3& size, const Pose& pose) {
+  Fixture f;
+  f.name = name;
+  Fixture::Geom g;
+  g.shape.kind = Shape::Kind::Box;
+  g.shape.size = size;
+  g.pose = pose;
+  f.geoms.push_back(g);
+  return f;
+}
+
+PartSpec cube(double edge, const Vec3& at) {
+  PartSpec p;
+  p.shape = Shape::Kind::Box;
+  for (auto& d : p.size) d.mean = edge;
+  p.density = 1000;
+  p.spawn_min = p.spawn_max = at;
+  p.count = 1;
+  return p;
+}
+
+}  // namespace
+
+Scene beltScene(double speed) {
+  Scene s;
+  s.name = "belt";
+  Pose pose;
+  pose.position = {0, 0, -0.05};
+  Fixture belt = boxFixture("belt", {2, 0.5, 0.1}, pose);
+  belt.law.kind = FeederLaw::Kind::Belt;
+  belt.law.belt_speed = speed;
+  s.fixtures.push_back(belt);
+  s.parts.push_back(cube(0.05, {-0.5, 0, 0.03}));
+  s.material.mu = 0.5;
+  s.duration = 1.0;
+  s.solver.time_step = 0.01;
+  s.solver.iterations = 100;
+  return s;
+}
+
+Scene inclineBeltScene(double angle, double speed) {
+  Scene s = beltScene(speed);
+  s.name = "incline_belt";
+  // Rotating about -y by `angle` lifts +x. The belt's top surface passes through the origin.
+  const Vec3 axis{0, -1, 0};
+  const Pose tilt = rotated(axis, angle, {0, 0, 0});
+  s.fixtures[0].geoms[0].pose = rotated(axis, angle, tilt.rotate({0, 0, -0.05}));
+  s.fixtures[0].law.belt_direction = {std::cos(angle), 0, std::sin(angle)};
+  PartSpec& p = s.parts[0];
+  p.spawn_min = p.spawn_max = tilt.rotate({-0.5, 0, 0.026});
+  s.parts[0].random_orientation = false;
+  s.duration = 1.0;
+  return s;
+}
+
+Scene turntableScene(double omega) {
+  Scene s;
+  s.name = "turntable";
+  Pose pose;
+  pose.position = {0, 0, -0.05};
+  Fixture table = boxFixture("table", {1, 1, 0.1}, pose);
+  table.law.kind = FeederLaw::Kind::Drift;
+  table.law.drift.angular = {0, 0, omega};
+  s.fixtures.push_back(table);
+  s.parts.push_back(cube(0.04, {0.15, 0, 0.021}));
+  s.parts.push_back(cube(0.04, {0.30, 0, 0.021}));
+  s.material.mu = 0.8;
+  s.duration = 0.5;
+  s.solver.time_step = 0.01;
+  s.solver.iterations = 100;
+  return s;
+}
+
+Scene helicalRampScene(double omega) {
+  Scene s;
+  s.name = omega >= 0 ? "helical_ramp_up" : "helical_ramp_down";
+  constexpr double kRadius = 0.3, kPitch = 0.1, kWidth = 0.1;
+  constexpr int kSegments = 48;  // per turn, 1.5 turns
+  const double slope = std::atan(kPitch / (2 * kPi * kRadius));
+  Fixture ramp;
+  ramp.name = "ramp";
+  const int total = kSegments * 3 / 2;
+  const double seg_angle = 2 * kPi / kSegments;
+  const double seg_length = 2 * kRadius * std::tan(seg_angle / 2) / std::cos(slope) * 1.05;
+  for (int i = 0; i < total; ++i) {
+    const double phi = (i + 0.5) * seg_angle;  // angle of the segment centre
+    const double z = kPitch * phi / (2 * kPi);
+    // Segment frame: x along the tangent (rising), y radial-in, z up; tilt by `slope` about
+    // the radial axis, then turn to phi.
+    const Pose heading = rotated({0, 0, 1}, phi + kPi / 2, {0, 0, 0});
+    // Turning the tangent about the outward radial axis r by +slope lifts it (r x t = +z).
+    const Vec3 radial = heading.rotate({0, -1, 0});
+    const Pose tilt = rotated(radial, slope, {0, 0, 0});
+    Pose p;
+    // Compose tilt * heading.
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0;
+        for (int k = 0; k < 3; ++k) sum += tilt.rotation[3 * r + k] * heading.rotation[3 * k + c];
+        p.rotation[3 * r + c] = sum;
+      }
+    }
+    const Vec3 centre{kRadius * std::cos(phi), kRadius * std::sin(phi), z};
+    p.position = centre - p.rotate({0, 0, 0.01});  // 2 cm thick, top face through the helix
+    Fixture::Geom g;
+    g.shape.kind = Shape::Kind::Box;
+    g.shape.size = {seg_length, kWidth, 0.02};
+    g.pose = p;
+    ramp.geoms.push_back(g);
+  }
+  ramp.law.kind = FeederLaw::Kind::Drift;
+  ramp.law.drift.angular = {0, 0, omega};
+  s.fixtures.push_back(ramp);
+  // A part on the first half turn.
+  const double phi0 = kPi / 2;
+  PartSpec part = cube(0.03, {kRadius * std::cos(phi0), kRadius * std::sin(phi0),
+                              kPitch * phi0 / (2 * kPi) + 0.017});
+  part.density = 1000;
+  s.parts.push_back(part);
+  s.material.mu = 0.8;
+  s.duration = 1.5;
+  s.solver.time_step = 0.005;
+  s.solver.iterations = 100;
+  return s;
+}
+
+Scene pileOnBeltScene(int count, double speed) {
+  Scene s = beltScene(speed);
+  s.name = "pile_on_belt";
+  PartSpec p;
+  p.shape = Shape::Kind::Box;
+  for (auto& d : p.size) {
+    d.mean = 0.04;
+    d.stddev = 0.004;
+    d.min = 0.03;
+    d.max = 0.05;
+  }
+  p.density = 1000;
+  p.spawn_min = {-0.8, -0.15, 0.04};
+  p.spawn_max = {-0.4, 0.15, 0.04 + 0.02 * count / 5.0};
+  p.count = count;
+  p.random_orientation = true;
+  s.parts = {p};
+  s.duration = 2.0;
+  return s;
+}
+
+}  // namespace rheofeed::scene

@@ -1,0 +1,193 @@
+// SPDX-License-Identifier: MIT
+// A scene run in ODE: stationary feeders driven by the plugin (rheonomic), or feeders on
+// kinematic bodies that really vibrate (full vibration; NOTES section 2 and 4: each step the
+// body is put on its law at t and given the secant velocity to its pose at t + h).
+#include <ode/ode.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <unordered_set>
+
+#include "geom_factory.hpp"
+#include "rheofeed/contact_collider.hpp"
+#include "rheofeed/feeder_set.hpp"
+#include "simulation_internal.hpp"
+
+namespace rheofeed::scene {
+namespace {
+
+class OdeSimulation final : public Simulation {
+ public:
+  OdeSimulation(const Scene& scene, Method method)
+      : scene_(scene), method_(method), instances_(drawParts(scene)) {
+    static const bool initialised = (dInitODE2(0), true);
+    (void)initialised;
+    world_ = dWorldCreate();
+    dWorldSetGravity(world_, scene.gravity.x, scene.gravity.y, scene.gravity.z);
+    dWorldSetERP(world_, scene.solver.erp);
+    dWorldSetCFM(world_, scene.solver.cfm);
+    dWorldSetQuickStepNumIterations(world_, scene.solver.iterations);
+    space_ = dHashSpaceCreate(nullptr);
+    feeders_ = std::make_unique<FeederSet>();
+
+    for (const Fixture& f : scene.fixtures) {
+      const bool vibrates = isFullVibration(method) && f.law.kind == FeederLaw::Kind::Vibration;
+      dBodyID body = nullptr;
+      if (vibrates) {
+        body = dBodyCreate(world_);
+        dBodySetKinematic(body);
+        vibrating_.push_back({body, f.law.vibration});
+      }
+      for (const Fixture::Geom& g : f.geoms) {
+        dGeomID geom = createGeom(space_, g.shape);
+        if (g.shape.kind != Shape::Kind::Plane) setGeomPose(geom, g.pose);
+        if (body) {
+          dGeomSetBody(geom, body);
+          dGeomSetOffsetWorldPosition(geom, g.pose.position.x, g.pose.position.y,
+                                      g.pose.position.z);
+          dMatrix3 r;
+          toOdeMatrix(g.pose, r);
+          dGeomSetOffsetWorldRotation(geom, r);
+        } else if (f.law.kind != FeederLaw::Kind::None) {
+          feeders_->add(geom, rheonomicLaw(f));
+        }
+        fixture_geoms_.insert(geom);
+      }
+    }
+
+    ContactCollider::Settings cs;
+    cs.feedback = true;
+    collider_ = std::make_unique<ContactCollider>(world_, *feeders_, cs);
+    const double mu = scene.material.mu, bounce = scene.material.restitution;
+    collider_->setSurfaceCallback([mu, bounce](dGeomID, dGeomID, dContact* c, int n) {
+      for (int i = 0; i < n; ++i) {
+        c[i].surface.mode = dContactApprox1 | (bounce > 0 ? dContactBounce : 0);
+        c[i].surface.mu = mu;
+        c[i].surface.bounce = bounce;
+        c[i].surface.bounce_vel = 0;
+      }
+      return true;
+    });
+    spawnDue();
+  }
+
+  ~OdeSimulation() override {
+    collider_.reset();
+    dSpaceDestroy(space_);
+    dWorldDestroy(world_);
+  }
+
+  void step() override {
+    const double h = scene_.solver.time_step;
+    for (const auto& [body, vibration] : vibrating_) driveKinematic(body, vibration, time_, h);
+    collider_->collide(space_, time_);
+    if (scene_.solver.ode_quickstep) {
+      dWorldQuickStep(world_, h);
+    } else {
+      dWorldStep(world_, h);
+    }
+    time_ = ++steps_ * h;
+    collectTotals(h);
+    spawnDue();
+  }
+
+  double time() const override { return time_; }
+  int numParts() const override { return static_cast<int>(parts_.size()); }
+  PartState part(int i) const override {
+    dBodyID b = parts_.at(static_cast<std::size_t>(i));
+    PartState s;
+    s.position = vec(dBodyGetPosition(b));
+    s.velocity = vec(dBodyGetLinearVel(b));
+    s.angular_velocity = vec(dBodyGetAngularVel(b));
+    const dReal* r = dBodyGetRotation(b);
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 3; ++col) s.rotation[3 * row + col] = r[4 * row + col];
+    }
+    return s;
+  }
+  double partMass(int i) const override { return instances_.at(static_cast<std::size_t>(i)).mass; }
+  ContactTotals contactTotals() const override { return totals_; }
+  Method method() const override { return method_; }
+
+ private:
+  static Vec3 vec(const dReal* a) { return {a[0], a[1], a[2]}; }
+  static void toOdeMatrix(const Pose& p, dMatrix3 r) {
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) r[4 * i + j] = p.rotation[3 * i + j];
+      r[4 * i + 3] = 0;
+    }
+  }
+
+  // Puts the kinematic body on its law at t and gives it the secant velocity to t + h.
+  static void driveKinematic(dBodyID body, const Vibration& v, double t, double h) {
+    const Pose p0 = v.displacement(t), p1 = v.displacement(t + h);
+    dBodySetPosition(body, p0.position.x, p0.position.y, p0.position.z);
+    dMatrix3 r;
+    toOdeMatrix(p0, r);
+    dBodySetRotation(body, r);
+    const Vec3 lin = (1.0 / h) * (p1.position - p0.position);
+    dBodySetLinearVel(body, lin.x, lin.y, lin.z);
+    const Vec3 ang = secantAngularVelocity(p0, p1, h);
+    dBodySetAngularVel(body, ang.x, ang.y, ang.z);
+  }
+
+  void spawnDue() {
+    while (next_ < instances_.size() && instances_[next_].spawn_time <= time_ + 1e-12) {
+      const PartInstance& p = instances_[next_++];
+      dBodyID b = dBodyCreate(world_);
+      dMass m;
+      dMassSetParameters(&m, p.mass, 0, 0, 0, p.inertia[0], p.inertia[4], p.inertia[8],
+                         p.inertia[1], p.inertia[2], p.inertia[5]);
+      dBodySetMass(b, &m);
+      dBodySetPosition(b, p.pose.position.x, p.pose.position.y, p.pose.position.z);
+      dMatrix3 r;
+      toOdeMatrix(p.pose, r);
+      dBodySetRotation(b, r);
+      dBodySetLinearVel(b, p.velocity.x, p.velocity.y, p.velocity.z);
+      dGeomSetBody(createGeom(space_, p.shape), b);
+      parts_.push_back(b);
+    }
+  }
+
+  // Impulses from fixtures on parts over the last step.
+  void collectTotals(double h) {
+    totals_ = {};
+    for (const ContactCollider::Joint& j : collider_->joints()) {
+      const bool f1 = fixture_geoms_.count(j.g1) != 0, f2 = fixture_geoms_.count(j.g2) != 0;
+      if (f1 == f2 || !j.feedback) continue;  // part-part or fixture-fixture
+      const dGeomID part = f1 ? j.g2 : j.g1;
+      const dBodyID body = dGeomGetBody(part);
+      const dReal* f = dJointGetBody(j.joint, 0) == body ? j.feedback->f1 : j.feedback->f2;
+      const Vec3 impulse = h * vec(f);
+      const Vec3 n_into_part = part == j.g1 ? j.normal : -j.normal;
+      ++totals_.count;
+      totals_.normal_impulse += dot(impulse, n_into_part);
+      totals_.impulse = totals_.impulse + impulse;
+    }
+  }
+
+  Scene scene_;
+  Method method_;
+  std::vector<PartInstance> instances_;
+  std::size_t next_ = 0;
+  dWorldID world_;
+  dSpaceID space_;
+  std::unique_ptr<FeederSet> feeders_;
+  std::unique_ptr<ContactCollider> collider_;
+  std::vector<std::pair<dBodyID, Vibration>> vibrating_;
+  std::unordered_set<dGeomID> fixture_geoms_;
+  std::vector<dBodyID> parts_;
+  double time_ = 0;
+  long steps_ = 0;
+  ContactTotals totals_;
+};
+
+}  // namespace
+
+std::unique_ptr<Simulation> makeOdeSimulation(const Scene& scene, Method method) {
+  return std::make_unique<OdeSimulation>(scene, method);
+}
+
+}  // namespace rheofeed::scene

@@ -1,0 +1,149 @@
+// SPDX-License-Identifier: MIT
+// A scene run in the reference world (rheofeed::reference::World, cone complementarity).
+#include <memory>
+#include <unordered_set>
+
+#include "geom_factory.hpp"
+#include "rheofeed/reference/world.hpp"
+#include "simulation_internal.hpp"
+
+namespace rheofeed::scene {
+namespace {
+
+using reference::BodyId;
+
+class ReferenceSimulation final : public Simulation {
+ public:
+  ReferenceSimulation(const Scene& scene, Method method)
+      : scene_(scene), method_(method), instances_(drawParts(scene)) {
+    reference::Settings s;
+    s.gravity = scene.gravity;
+    s.erp = scene.solver.erp;
+    s.cfm = scene.solver.cfm;
+    s.default_mu = scene.material.mu;
+    s.solver.method = scene.solver.apgd ? ccp::Method::Apgd : ccp::Method::Pgs;
+    s.solver.max_iterations = scene.solver.iterations;
+    s.solver.tolerance = scene.solver.tolerance;
+    world_ = std::make_unique<reference::World>(s);
+
+    for (const Fixture& f : scene.fixtures) {
+      const bool vibrates = isFullVibration(method) && f.law.kind == FeederLaw::Kind::Vibration;
+      BodyId body = reference::kStatic;
+      if (vibrates) {
+        const Vibration v = f.law.vibration;
+        body = world_->addKinematicBody([v](double t) { return v.displacement(t); });
+      }
+      for (const Fixture::Geom& g : f.geoms) {
+        dGeomID geom = createGeom(world_->space(), g.shape);
+        if (g.shape.kind != Shape::Kind::Plane) setGeomPose(geom, g.pose);
+        if (body != reference::kStatic) {
+          world_->attachGeom(geom, body, g.pose);  // the body's rest pose is the identity
+        } else if (f.law.kind != FeederLaw::Kind::None) {
+          world_->setFeeder(geom, rheonomicLaw(f));
+        }
+        fixture_geoms_.insert(geom);
+      }
+    }
+    spawnDue();
+  }
+
+  void step() override {
+    const double h = scene_.solver.time_step;
+    world_->step(h);
+    time_ = ++steps_ * h;
+    collectTotals();
+    spawnDue();
+  }
+
+  double time() const override { return time_; }
+  int numParts() const override { return static_cast<int>(parts_.size()); }
+  PartState part(int i) const override {
+    const reference::BodyState& b = world_->state(parts_.at(static_cast<std::size_t>(i)));
+    PartState s;
+    s.position = b.position;
+    s.velocity = b.linear_velocity;
+    s.angular_velocity = b.angular_velocity;
+    const reference::Quat& q = b.orientation;
+    double* r = s.rotation;
+    r[0] = 1 - 2 * (q.y * q.y + q.z * q.z);
+    r[1] = 2 * (q.x * q.y - q.z * q.w);
+    r[2] = 2 * (q.x * q.z + q.y * q.w);
+    r[3] = 2 * (q.x * q.y + q.z * q.w);
+    r[4] = 1 - 2 * (q.x * q.x + q.z * q.z);
+    r[5] = 2 * (q.y * q.z - q.x * q.w);
+    r[6] = 2 * (q.x * q.z - q.y * q.w);
+    r[7] = 2 * (q.y * q.z + q.x * q.w);
+    r[8] = 1 - 2 * (q.x * q.x + q.y * q.y);
+    return s;
+  }
+  double partMass(int i) const override { return instances_.at(static_cast<std::size_t>(i)).mass; }
+  ContactTotals contactTotals() const override { return totals_; }
+  Method method() const override { return method_; }
+
+ private:
+  void spawnDue() {
+    while (next_ < instances_.size() && instances_[next_].spawn_time <= time_ + 1e-12) {
+      const PartInstance& p = instances_[next_++];
+      reference::BodyState state;
+      state.position = p.pose.position;
+      state.linear_velocity = p.velocity;
+      state.orientation = quatOf(p.pose);
+      const BodyId body = world_->addBody(p.mass, p.inertia, state);
+      world_->attachGeom(createGeom(world_->space(), p.shape), body);
+      parts_.push_back(body);
+    }
+  }
+
+  static reference::Quat quatOf(const Pose& pose) {
+    const double* m = pose.rotation;
+    reference::Quat q;
+    const double tr = m[0] + m[4] + m[8];
+    if (tr > 0) {
+      const double s = 0.5 / std::sqrt(tr + 1.0);
+      q = {0.25 / s, (m[7] - m[5]) * s, (m[2] - m[6]) * s, (m[3] - m[1]) * s};
+    } else if (m[0] > m[4] && m[0] > m[8]) {
+      const double s = 2.0 * std::sqrt(1.0 + m[0] - m[4] - m[8]);
+      q = {(m[7] - m[5]) / s, 0.25 * s, (m[1] + m[3]) / s, (m[2] + m[6]) / s};
+    } else if (m[4] > m[8]) {
+      const double s = 2.0 * std::sqrt(1.0 + m[4] - m[0] - m[8]);
+      q = {(m[2] - m[6]) / s, (m[1] + m[3]) / s, 0.25 * s, (m[5] + m[7]) / s};
+    } else {
+      const double s = 2.0 * std::sqrt(1.0 + m[8] - m[0] - m[4]);
+      q = {(m[3] - m[1]) / s, (m[2] + m[6]) / s, (m[5] + m[7]) / s, 0.25 * s};
+    }
+    return q;
+  }
+
+  void collectTotals() {
+    totals_ = {};
+    for (const reference::ContactImpulse& c : world_->contacts()) {
+      const bool f1 = fixture_geoms_.count(c.g1) != 0, f2 = fixture_geoms_.count(c.g2) != 0;
+      if (f1 == f2) continue;
+      // Impulse on body1 (g1) is gamma_n n + gamma_t; on g2 its opposite.
+      const Vec3 on_g1 = c.normal_impulse * c.normal + c.tangential_impulse;
+      const Vec3 impulse = f1 ? -on_g1 : on_g1;
+      ++totals_.count;
+      totals_.normal_impulse += c.normal_impulse;
+      totals_.impulse = totals_.impulse + impulse;
+    }
+  }
+
+  Scene scene_;
+  Method method_;
+  std::vector<PartInstance> instances_;
+  std::size_t next_ = 0;
+  std::unique_ptr<reference::World> world_;
+  std::unordered_set<dGeomID> fixture_geoms_;
+  std::vector<BodyId> parts_;
+  double time_ = 0;
+  long steps_ = 0;
+  ContactTotals totals_;
+};
+
+}  // namespace
+
+std::unique_ptr<Simulation> makeReferenceSimulation(const Scene& scene, Method method) {
+  return std::make_unique<ReferenceSimulation>(scene, method);
+}
+
+}  // namespace rheofeed::scene

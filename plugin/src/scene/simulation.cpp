@@ -1,0 +1,31 @@
+// SPDX-License-Identifier: MIT
+#include "rheofeed/scene/simulation.hpp"
+
+#include <Eigen/Geometry>
+
+#include "simulation_internal.hpp"
+
+namespace rheofeed::scene {
+
+Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h) {
+  Eigen::Matrix3d r0, r1;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      r0(i, j) = p0.rotation[3 * i + j];
+      r1(i, j) = p1.rotation[3 * i + j];
+    }
+  }
+  const Eigen::AngleAxisd rel(r1 * r0.transpose());
+  const Eigen::Vector3d w = rel.axis() * (rel.angle() / h);
+  return {w.x(), w.y(), w.z()};
+}
+
+std::unique_ptr<Simulation> makeSimulation(const Scene& scene, Method method) {
+  scene.validate();
+  if (method == Method::OdeRheonomic || method == Method::OdeFullVibration) {
+    return makeOdeSimulation(scene, method);
+  }
+  return makeReferenceSimulation(scene, method);
+}
+
+}  // namespace rheofeed::scene
