@@ -115,6 +115,7 @@ struct World::Impl {
   std::vector<ContactImpulse> contacts;
   std::map<std::tuple<dGeomID, dGeomID, int>, Vector3d> warm;
   std::vector<dContactGeom> scratch;
+  ccp::Problem problem;  // the last step's contact problem
 
   BodyId bodyOf(dGeomID g) const {
     auto it = attached.find(g);
@@ -197,7 +198,11 @@ struct World::Impl {
   }
 };
 
-World::World(const Settings& settings) : impl_(std::make_unique<Impl>()) {
+namespace {
+
+// Empty when `settings` are usable, else a message naming the first bad value. Checked by the
+// constructor and again by every step, since World::settings() hands out a mutable reference.
+std::string settingsProblem(const Settings& settings) {
   std::ostringstream bad;
   if (!(settings.erp >= 0 && settings.erp <= 1))
     bad << "Settings::erp = " << settings.erp << " must be in [0, 1]";
@@ -217,7 +222,13 @@ World::World(const Settings& settings) : impl_(std::make_unique<Impl>()) {
     bad << "Settings::gravity is not finite";
   else if (std::string m = settings.solver.validate(); !m.empty())
     bad << "Settings::solver: " << m;
-  if (!bad.str().empty()) refuse(bad.str());
+  return bad.str();
+}
+
+}  // namespace
+
+World::World(const Settings& settings) : impl_(std::make_unique<Impl>()) {
+  if (std::string bad = settingsProblem(settings); !bad.empty()) refuse(bad);
   impl_->settings = settings;
   impl_->solver.settings() = settings.solver;
   impl_->space = dHashSpaceCreate(nullptr);
@@ -321,6 +332,7 @@ StepReport World::step(double h) {
     out << "step: h = " << h << " must be finite and > 0 (s)";
     refuse(out.str());
   }
+  if (std::string bad = settingsProblem(s.settings); !bad.empty()) refuse("step: " + bad);
   const Settings& cfg = s.settings;
 
   // Kinematic bodies: secant velocity over [t, t + h], pose at t + h applied after the step.
@@ -329,7 +341,14 @@ StepReport World::step(double h) {
     Impl::Body& b = s.bodies[k];
     if (!b.kinematic) continue;
     const Pose p0 = b.motion(s.time), p1 = b.motion(s.time + h);
-    if (!isFinite(p0.position) || !isFinite(p1.position)) refuse("kinematic motion is not finite");
+    if (!isFinite(p0.position) || !isFinite(p1.position)) {
+      const bool first = !isFinite(p0.position);
+      const Vec3& x = first ? p0.position : p1.position;
+      std::ostringstream out;
+      out << "step: kinematic body " << k << ": motion(t = " << (first ? s.time : s.time + h)
+          << ").position = (" << x.x << ", " << x.y << ", " << x.z << ") is not finite";
+      refuse(out.str());
+    }
     const Matrix3d r0 = rotationOf(p0), r1 = rotationOf(p1);
     const Eigen::AngleAxisd rel(r1 * r0.transpose());
     b.state.position = p0.position;
@@ -429,14 +448,23 @@ StepReport World::step(double h) {
     minv.setFromTriplets(m_entries.begin(), m_entries.end());
 
     const double compliance = cfg.cfm / h;
-    ccp::Problem problem;
+    ccp::Problem& problem = s.problem;
     if (nc <= cfg.dense_contact_limit) {
       Eigen::MatrixXd n = Eigen::MatrixXd(d.transpose() * (minv * d));
       n.diagonal().array() += compliance;
       problem = ccp::Problem::makeDense(std::move(n), r, mu);
     } else {
-      problem = ccp::Problem::makeMatrixFree(d, minv, r, mu);
-      // COMPLIANCE-PENDING problem.compliance = compliance;
+      // N + c I = [D; sqrt(c) I]^T blkdiag(M^-1, I) [D; sqrt(c) I]: the compliance enters the
+      // matrix-free operator as 3 nc virtual unit-mass coordinates, one per contact row.
+      const double root = std::sqrt(compliance);
+      ccp::SparseMatrix d_aug(ndof + 3 * nc, 3 * nc), minv_aug(ndof + 3 * nc, ndof + 3 * nc);
+      for (int k = 0; k < 3 * nc; ++k) {
+        d_entries.emplace_back(ndof + k, k, root);
+        m_entries.emplace_back(ndof + k, ndof + k, 1.0);
+      }
+      d_aug.setFromTriplets(d_entries.begin(), d_entries.end());
+      minv_aug.setFromTriplets(m_entries.begin(), m_entries.end());
+      problem = ccp::Problem::makeMatrixFree(std::move(d_aug), std::move(minv_aug), r, mu);
     }
 
     Eigen::VectorXd gamma = Eigen::VectorXd::Zero(3 * nc);
@@ -447,6 +475,7 @@ StepReport World::step(double h) {
         if (it != s.warm.end()) gamma.segment<3>(3 * i) = it->second;
       }
     }
+    s.solver.settings() = cfg.solver;
     report.solve = s.solver.solve(problem, gamma);
     if (report.solve.status == ccp::Status::InvalidInput) {
       refuse("step: the contact problem was refused: " + report.solve.message);

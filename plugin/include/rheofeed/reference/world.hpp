@@ -38,6 +38,7 @@
 #include <string>
 #include <vector>
 
+#include "rheofeed/ccp/problem.hpp"
 #include "rheofeed/ccp/solver.hpp"
 #include "rheofeed/motion_law.hpp"
 #include "rheofeed/vec3.hpp"
@@ -143,7 +144,10 @@ class World {
   double mass(BodyId body) const;  ///< (kg); infinity for a kinematic body
   /// Contacts of the last step with their impulses.
   const std::vector<ContactImpulse>& contacts() const;
+  /// Settings; changes apply from the next step.
   Settings& settings();
+  /// The contact problem of the last step with contacts (for benchmarks and inspection).
+  const ccp::Problem& lastProblem() const;
 
  private:
   struct Impl;

@@ -1,0 +1,167 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+/// @file
+/// Iterative solvers for the cone complementarity problem of problem.hpp: block projected
+/// Gauss-Seidel (Tasora & Anitescu) and APGD, Nesterov's accelerated projected gradient
+/// (Mazhar, Heyn, Negrut & Tasora, ACM TOG 2015), with an optional outer fixed point that turns
+/// the convex relaxation into the true Coulomb law (Acary, Cadoux, Lemarechal & Malick 2011).
+///
+/// A solver is Settings + Problem + a workspace owned by Solver + a Result. Once a Solver has
+/// solved a problem of a given size (nc contacts, ndof generalised velocities), later solves of
+/// problems of the same size do not allocate on the heap (unless they fail: error messages are
+/// strings).
+///
+/// Quality measures (Result), all computed from the returned gamma with `u = N gamma + r`, with
+/// per contact i the friction cone K_i, its dual K_i* and rho = Settings::residual_rho:
+/// - residual: `||gamma - Pi_K(gamma - rho u)|| / (1 + ||r||)` (Euclidean norm over all
+///   contacts), the natural map of the CCP; zero exactly at a solution, and the stopping test.
+/// - dual_infeasibility: `sqrt(sum_i dist(u_i, K_i*)^2)` with `dist(u, K*) = ||Pi_K(-u)||` (m/s),
+///   how far the velocities are from the relaxed law `u_n >= mu ||u_t||`.
+/// - complementarity: `sum_i |gamma_i . u_i|` (N m), zero at a solution (per-contact absolute
+///   values, so that contacts cannot cancel each other).
+/// - objective: `1/2 gamma^T N gamma + r^T gamma` (J), minimal at the solution.
+/// - coulomb_distance: the natural map residual of the true Coulomb law, `u_n` replaced by
+///   `u_n + mu ||u_t||` (De Saxce's modified velocity), same normalisation as residual. It
+///   equals the relaxed residual where no contact slides. With rho = 1 it is comparable to the
+///   error measure of Siconos for fc3d problems (same modified velocity; other normalisation).
+
+#include "rheofeed/ccp/problem.hpp"
+
+#include <Eigen/Core>
+
+#include <limits>
+#include <memory>
+#include <string>
+
+namespace rheofeed::ccp {
+
+/// Iterative method used by Solver.
+enum class Method {
+  /// Block projected Gauss-Seidel, one 3 x 3 block (contact) at a time.
+  Pgs,
+  /// Accelerated projected gradient descent (Nesterov) with adaptive step and restart.
+  Apgd,
+};
+
+/// Printable name of a Method ("PGS", "APGD").
+const char* toString(Method method);
+
+/// Outcome of Solver::solve. Starts at NotRun.
+enum class Status {
+  /// No solve has produced this result.
+  NotRun,
+  /// The residual is at or below Settings::tolerance (and, in Coulomb mode, the fixed point
+  /// moved less than Settings::coulomb_tolerance).
+  Converged,
+  /// The iteration or time budget ran out first; gamma is the best iterate found.
+  MaxIterations,
+  /// A non-finite value appeared during the iterations; gamma is the last finite best iterate.
+  NumericalIssue,
+  /// Problem::validate() or the settings refused the input; gamma is untouched.
+  InvalidInput,
+};
+
+/// Printable name of a Status ("NotRun", "Converged", ...).
+const char* toString(Status status);
+
+/// Solver settings. Defaults are in the class; all are checked by solve().
+struct Settings {
+  /// Iterative method.
+  Method method = Method::Apgd;
+  /// Iteration budget of one relaxed solve: PGS sweeps over all contacts, or APGD iterations
+  /// (>= 1). In Coulomb mode it applies to each inner solve.
+  int max_iterations = 10000;
+  /// Stop when the natural map residual (see Result::residual, dimensionless by its
+  /// normalisation for consistent units) is at or below this value (>= 0).
+  double tolerance = 1e-8;
+  /// Scale rho of the natural map `gamma - Pi_K(gamma - rho u)` (unit: N s per m/s = kg; > 0).
+  double residual_rho = 1.0;
+  /// PGS over-relaxation (dimensionless, 0 < omega < 2; 1 means none): the block step of contact
+  /// i is `min(omega * 3 / trace(N_ii), 1.9 / lambda_max(N_ii))` (unit: impulse per velocity,
+  /// kg). The cap keeps each block update a descent step on strongly anisotropic blocks.
+  double omega = 1.0;
+  /// Use the incoming gamma as the initial guess (projected onto K) when it has the right size
+  /// and finite entries; otherwise start from zero.
+  bool warm_start = true;
+  /// Dense PGS updates `u = N gamma + r` incrementally; recompute it from scratch every this many
+  /// sweeps to remove round-off drift (>= 1). Matrix-free PGS does the same for `M^-1 D gamma`.
+  int pgs_refresh_interval = 64;
+  /// Wall-clock budget of the whole solve (s); 0 means none. When exceeded, the solve stops with
+  /// Status::MaxIterations and the best iterate.
+  double time_limit_s = 0.0;
+  /// Outer fixed-point iterations of the true Coulomb mode (>= 0). 0 solves the convex
+  /// relaxation (the CCP). k > 0 solves up to k relaxed problems with `r_n` replaced by
+  /// `r_n + mu ||u_t||` from the previous solution, warm-started, until the added term changes by
+  /// less than coulomb_tolerance.
+  int coulomb_outer_iterations = 0;
+  /// Coulomb mode stops when `||s_new - s_old|| / (1 + ||r||) <= coulomb_tolerance`, where
+  /// `s_i = mu_i ||u_t,i||` (m/s) is the normal shift (>= 0, dimensionless like tolerance).
+  double coulomb_tolerance = 1e-8;
+
+  /// Empty when the settings are usable, else a message naming the bad field and its value.
+  std::string validate() const;
+};
+
+/// What a solve produced. Measures are defined in this file's header comment; they are NaN
+/// when not computed (NotRun, InvalidInput).
+struct Result {
+  /// Outcome.
+  Status status = Status::NotRun;
+  /// Details for InvalidInput, NumericalIssue and non-converged Coulomb mode; empty otherwise.
+  std::string message;
+  /// Iterations performed (PGS sweeps or APGD iterations), summed over Coulomb outer iterations.
+  int iterations = 0;
+  /// Relaxed problems solved in Coulomb mode (0 when Settings::coulomb_outer_iterations == 0).
+  int outer_iterations = 0;
+  /// Natural map residual of the (last) relaxed problem solved, `/(1 + ||r||)` (dimensionless
+  /// for consistent units). In Coulomb mode `r` is the shifted one of the last inner solve.
+  double residual = std::numeric_limits<double>::quiet_NaN();
+  /// Distance of `u` to the dual cones (m/s), for the problem's own `r`.
+  double dual_infeasibility = std::numeric_limits<double>::quiet_NaN();
+  /// `sum_i |gamma_i . u_i|` (N m), for the problem's own `r`.
+  double complementarity = std::numeric_limits<double>::quiet_NaN();
+  /// `1/2 gamma^T N gamma + r^T gamma` (J), for the problem's own `r`.
+  double objective = std::numeric_limits<double>::quiet_NaN();
+  /// Natural map residual of the true Coulomb law, for the problem's own `r`.
+  double coulomb_distance = std::numeric_limits<double>::quiet_NaN();
+  /// Wall-clock time of solve() (s).
+  double solve_time_s = 0.0;
+};
+
+/// Cone complementarity solver with a reusable workspace. Not thread safe: use one Solver per
+/// thread. Never throws for bad input (Status::InvalidInput).
+class Solver {
+ public:
+  /// A solver with default Settings.
+  Solver();
+  /// A solver with the given settings (checked at each solve).
+  explicit Solver(const Settings& settings);
+  /// Releases the workspace.
+  ~Solver();
+  /// Moves settings and workspace.
+  Solver(Solver&&) noexcept;
+  /// Moves settings and workspace.
+  Solver& operator=(Solver&&) noexcept;
+  /// Not copyable: the workspace is per solver.
+  Solver(const Solver&) = delete;
+  /// Not copyable: the workspace is per solver.
+  Solver& operator=(const Solver&) = delete;
+
+  /// Current settings (read only).
+  const Settings& settings() const { return settings_; }
+  /// Current settings, to modify between solves.
+  Settings& settings() { return settings_; }
+
+  /// Solves `problem`. `gamma` (3 nc impulses, N s, (n, u, v) per contact) is the warm start on
+  /// input (see Settings::warm_start) and the best iterate on output (always in K), except on
+  /// InvalidInput where it is untouched.
+  Result solve(const Problem& problem, Eigen::VectorXd& gamma);
+
+ private:
+  struct Workspace;
+  Settings settings_;
+  std::unique_ptr<Workspace> workspace_;
+};
+
+}  // namespace rheofeed::ccp

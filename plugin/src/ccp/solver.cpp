@@ -1,0 +1,279 @@
+// SPDX-License-Identifier: MIT
+//
+// Solver front end: settings and input checks, warm start, the true-Coulomb outer fixed point,
+// and the quality measures of the returned impulses. The inner relaxed solvers are in pgs.cpp
+// and apgd.cpp.
+//
+// True Coulomb mode (Acary, Cadoux, Lemarechal & Malick, "A formulation of the linear discrete
+// Coulomb friction problem via convex optimization", ZAMM 2011): the Coulomb law is the CCP
+// written for De Saxce's modified velocity `u + mu ||u_t|| e_n`. Freezing `s_i = mu_i ||u_t,i||`
+// makes it the relaxed CCP with `r_n` replaced by `r_n + s`; iterating `s <- mu ||u_t(gamma(s))||`
+// is a fixed point whose limit solves the Coulomb problem (a sliding contact then has u_n = 0
+// instead of the relaxation's u_n = mu ||u_t||). Tangential velocities are not changed by the
+// shift, so `u_t` can be read from either problem.
+
+#include "rheofeed/ccp/solver.hpp"
+
+#include "rheofeed/ccp/cone.hpp"
+#include "solver_internal.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace rheofeed::ccp {
+
+namespace detail {
+
+void Workspace::resize(Eigen::Index nc, Eigen::Index ndof) {
+  const Eigen::Index n = 3 * nc;
+  for (Eigen::VectorXd* v : {&u, &r_shifted, &iterate, &n_iterate, &next, &n_next, &y, &n_y, &best})
+    v->resize(n);
+  for (Eigen::VectorXd* v : {&eta, &shift, &shift_new}) v->resize(nc);
+  dof_a.resize(ndof);
+  dof_b.resize(ndof);
+}
+
+void multiplyDelassus(const Problem& problem, const Eigen::VectorXd& x, Eigen::VectorXd& y,
+                      Workspace& ws) {
+  if (problem.form == DelassusForm::Dense) {
+    y.noalias() = problem.delassus * x;
+    return;
+  }
+  // dof_a = D x
+  const SparseMatrix& d = problem.d;
+  ws.dof_a.setZero();
+  for (Eigen::Index col = 0; col < d.outerSize(); ++col) {
+    const double xc = x[col];
+    if (xc == 0.0) continue;
+    for (SparseMatrix::InnerIterator it(d, col); it; ++it) ws.dof_a[it.row()] += it.value() * xc;
+  }
+  // dof_b = M^-1 dof_a
+  const SparseMatrix& minv = problem.minv;
+  ws.dof_b.setZero();
+  for (Eigen::Index col = 0; col < minv.outerSize(); ++col) {
+    const double a = ws.dof_a[col];
+    if (a == 0.0) continue;
+    for (SparseMatrix::InnerIterator it(minv, col); it; ++it) ws.dof_b[it.row()] += it.value() * a;
+  }
+  // y = D^T dof_b
+  for (Eigen::Index col = 0; col < d.outerSize(); ++col) {
+    double sum = 0.0;
+    for (SparseMatrix::InnerIterator it(d, col); it; ++it) sum += it.value() * ws.dof_b[it.row()];
+    y[col] = sum;
+  }
+}
+
+double naturalMap(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u, const Eigen::VectorXd& mu,
+                  double rho) {
+  double sum = 0.0;
+  for (Eigen::Index i = 0; i < mu.size(); ++i) {
+    const Eigen::Vector3d g = gamma.segment<3>(3 * i);
+    const Eigen::Vector3d trial = g - rho * u.segment<3>(3 * i);
+    sum += (g - projectOntoCone(trial, mu[i])).squaredNorm();
+  }
+  return std::sqrt(sum);
+}
+
+void projectOntoCones(Eigen::VectorXd& gamma, const Eigen::VectorXd& mu) {
+  for (Eigen::Index i = 0; i < mu.size(); ++i) {
+    gamma.segment<3>(3 * i) = projectOntoCone(gamma.segment<3>(3 * i), mu[i]);
+  }
+}
+
+}  // namespace detail
+
+namespace {
+
+std::string format(const char* fmt, double a, double b = 0.0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, fmt, a, b);
+  return std::string(buffer);
+}
+
+// Fills the measures of `result` for impulses gamma with u = N gamma + r (u given).
+void computeMeasures(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
+                     const Eigen::VectorXd& r, const Eigen::VectorXd& mu, double rho,
+                     Result& result) {
+  const double scale = 1.0 + r.norm();
+  double dual = 0.0;
+  double complementarity = 0.0;
+  double coulomb = 0.0;
+  for (Eigen::Index i = 0; i < mu.size(); ++i) {
+    const Eigen::Vector3d g = gamma.segment<3>(3 * i);
+    const Eigen::Vector3d ui = u.segment<3>(3 * i);
+    dual += projectOntoCone(-ui, mu[i]).squaredNorm();
+    complementarity += std::abs(g.dot(ui));
+    Eigen::Vector3d modified = ui;
+    modified[0] += mu[i] * ui.tail<2>().norm();
+    coulomb += (g - projectOntoCone(g - rho * modified, mu[i])).squaredNorm();
+  }
+  result.dual_infeasibility = std::sqrt(dual);
+  result.complementarity = complementarity;
+  // 1/2 g^T N g + r^T g with N g = u - r.
+  result.objective = 0.5 * gamma.dot(u + r);
+  result.coulomb_distance = std::sqrt(coulomb) / scale;
+}
+
+}  // namespace
+
+const char* toString(Method method) {
+  switch (method) {
+    case Method::Pgs:
+      return "PGS";
+    case Method::Apgd:
+      return "APGD";
+  }
+  return "Unknown";
+}
+
+const char* toString(Status status) {
+  switch (status) {
+    case Status::NotRun:
+      return "NotRun";
+    case Status::Converged:
+      return "Converged";
+    case Status::MaxIterations:
+      return "MaxIterations";
+    case Status::NumericalIssue:
+      return "NumericalIssue";
+    case Status::InvalidInput:
+      return "InvalidInput";
+  }
+  return "Unknown";
+}
+
+std::string Settings::validate() const {
+  if (method != Method::Pgs && method != Method::Apgd) return "method is not PGS or APGD";
+  if (max_iterations < 1) return format("max_iterations = %g must be >= 1", max_iterations);
+  if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) {
+    return format("tolerance = %g must be finite and >= 0", tolerance);
+  }
+  if (!(residual_rho > 0.0) || !std::isfinite(residual_rho)) {
+    return format("residual_rho = %g must be finite and > 0", residual_rho);
+  }
+  if (!(omega > 0.0 && omega < 2.0)) return format("omega = %g must be in (0, 2)", omega);
+  if (pgs_refresh_interval < 1) {
+    return format("pgs_refresh_interval = %g must be >= 1", pgs_refresh_interval);
+  }
+  if (!(time_limit_s >= 0.0)) return format("time_limit_s = %g must be >= 0", time_limit_s);
+  if (coulomb_outer_iterations < 0) {
+    return format("coulomb_outer_iterations = %g must be >= 0", coulomb_outer_iterations);
+  }
+  if (!(coulomb_tolerance >= 0.0) || !std::isfinite(coulomb_tolerance)) {
+    return format("coulomb_tolerance = %g must be finite and >= 0", coulomb_tolerance);
+  }
+  return {};
+}
+
+struct Solver::Workspace : detail::Workspace {};
+
+Solver::Solver() = default;
+Solver::Solver(const Settings& settings) : settings_(settings) {}
+Solver::~Solver() = default;
+Solver::Solver(Solver&&) noexcept = default;
+Solver& Solver::operator=(Solver&&) noexcept = default;
+
+Result Solver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
+  const detail::Deadline deadline(settings_.time_limit_s);
+  Result result;
+  auto finish = [&]() -> Result {
+    result.solve_time_s = deadline.elapsed();
+    return std::move(result);
+  };
+
+  if (std::string message = settings_.validate(); !message.empty()) {
+    result.status = Status::InvalidInput;
+    result.message = "invalid settings: " + message;
+    return finish();
+  }
+  if (std::string message = problem.validate(); !message.empty()) {
+    result.status = Status::InvalidInput;
+    result.message = "invalid problem: " + message;
+    return finish();
+  }
+
+  const Eigen::Index nc = problem.numContacts();
+  const Eigen::Index n = problem.size();
+  if (!workspace_) workspace_ = std::make_unique<Workspace>();
+  detail::Workspace& ws = *workspace_;
+  ws.resize(nc, problem.numDofs());
+
+  const bool warm = settings_.warm_start && gamma.size() == n && gamma.allFinite();
+  if (warm) {
+    detail::projectOntoCones(gamma, problem.mu);
+  } else {
+    gamma.resize(n);
+    gamma.setZero();
+  }
+
+  auto inner = [&](const Eigen::VectorXd& r) {
+    return settings_.method == Method::Pgs
+               ? detail::runPgs(problem, r, settings_, deadline, gamma, ws)
+               : detail::runApgd(problem, r, settings_, deadline, gamma, ws);
+  };
+  // ws.u = N gamma + r_problem; used for the shift and the final measures.
+  auto physicalVelocity = [&]() {
+    detail::multiplyDelassus(problem, gamma, ws.u, ws);
+    ws.u += problem.r;
+  };
+  auto updateShift = [&](Eigen::VectorXd& shift) {
+    for (Eigen::Index i = 0; i < nc; ++i)
+      shift[i] = problem.mu[i] * ws.u.segment<2>(3 * i + 1).norm();
+  };
+
+  detail::InnerOutcome outcome;
+  if (n == 0) {
+    outcome.status = Status::Converged;
+  } else if (settings_.coulomb_outer_iterations == 0) {
+    outcome = inner(problem.r);
+    result.iterations = outcome.iterations;
+  } else {
+    const double scale = 1.0 + problem.r.norm();
+    physicalVelocity();
+    updateShift(ws.shift);
+    bool fixed_point_reached = false;
+    double change = 0.0;
+    for (int outer = 0; outer < settings_.coulomb_outer_iterations; ++outer) {
+      ws.r_shifted = problem.r;
+      for (Eigen::Index i = 0; i < nc; ++i) ws.r_shifted[3 * i] += ws.shift[i];
+      outcome = inner(ws.r_shifted);
+      result.iterations += outcome.iterations;
+      result.outer_iterations = outer + 1;
+      if (outcome.status == Status::NumericalIssue || outcome.timed_out) break;
+      physicalVelocity();
+      updateShift(ws.shift_new);
+      change = (ws.shift_new - ws.shift).norm() / scale;
+      ws.shift.swap(ws.shift_new);
+      if (change <= settings_.coulomb_tolerance && outcome.status == Status::Converged) {
+        fixed_point_reached = true;
+        break;
+      }
+    }
+    if (outcome.status != Status::NumericalIssue && !outcome.timed_out && !fixed_point_reached) {
+      outcome.status = Status::MaxIterations;
+      result.message = format(
+          "Coulomb fixed point not reached: last change of mu ||u_t|| was %g (scaled) after %g "
+          "outer iterations",
+          change, result.outer_iterations);
+    }
+  }
+
+  result.status = outcome.status;
+  if (outcome.status == Status::NumericalIssue && outcome.issue != nullptr) {
+    result.message = outcome.issue;
+  } else if (outcome.timed_out) {
+    result.message = format("time limit of %g s reached", deadline.limit());
+  }
+  physicalVelocity();
+  computeMeasures(gamma, ws.u, problem.r, problem.mu, settings_.residual_rho, result);
+  if (settings_.coulomb_outer_iterations == 0) {
+    result.residual = detail::naturalMap(gamma, ws.u, problem.mu, settings_.residual_rho) /
+                      (1.0 + problem.r.norm());
+  } else {
+    result.residual = outcome.residual;
+  }
+  return finish();
+}
+
+}  // namespace rheofeed::ccp

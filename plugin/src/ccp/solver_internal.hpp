@@ -1,0 +1,88 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Internal pieces shared by solver.cpp, pgs.cpp and apgd.cpp: the workspace, the Delassus
+// products, the residual and the inner (relaxed) solvers. Not installed.
+
+#include "rheofeed/ccp/problem.hpp"
+#include "rheofeed/ccp/solver.hpp"
+
+#include <Eigen/Core>
+
+#include <chrono>
+
+namespace rheofeed::ccp::detail {
+
+/// Preallocated vectors. resize() only allocates when a size changes.
+struct Workspace {
+  // Contact space (3 nc).
+  Eigen::VectorXd u;          // contact velocity N gamma + r of the current iterate
+  Eigen::VectorXd r_shifted;  // Coulomb mode: r with mu ||u_t|| added to the normal rows
+  Eigen::VectorXd iterate;    // APGD gamma_k, PGS current gamma
+  Eigen::VectorXd n_iterate;  // APGD N gamma_k
+  Eigen::VectorXd next;       // APGD gamma_{k+1}
+  Eigen::VectorXd n_next;     // APGD N gamma_{k+1}
+  Eigen::VectorXd y;          // APGD extrapolated point
+  Eigen::VectorXd n_y;        // APGD N y
+  Eigen::VectorXd best;       // best iterate by residual
+  // Contacts (nc).
+  Eigen::VectorXd eta;        // PGS block step 3 / trace(N_ii)
+  Eigen::VectorXd shift;      // Coulomb mode: current s_i = mu_i ||u_t,i||
+  Eigen::VectorXd shift_new;  // Coulomb mode: next s_i
+  // Generalised velocities (ndof), matrix-free only.
+  Eigen::VectorXd dof_a;
+  Eigen::VectorXd dof_b;
+
+  void resize(Eigen::Index nc, Eigen::Index ndof);
+};
+
+/// Wall-clock budget of one Solver::solve call.
+class Deadline {
+ public:
+  explicit Deadline(double limit_s) : start_(std::chrono::steady_clock::now()), limit_s_(limit_s) {}
+  /// Seconds since construction.
+  double elapsed() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+  /// True when a limit is set and exceeded.
+  bool expired() const { return limit_s_ > 0.0 && elapsed() > limit_s_; }
+  double limit() const { return limit_s_; }
+
+ private:
+  std::chrono::steady_clock::time_point start_;
+  double limit_s_;
+};
+
+/// What an inner (relaxed) solve reports back.
+struct InnerOutcome {
+  Status status = Status::NotRun;
+  int iterations = 0;
+  /// Scaled natural map residual of the returned iterate.
+  double residual = 0.0;
+  /// True when the time budget stopped the solve.
+  bool timed_out = false;
+  /// Static description of a numerical issue (nullptr otherwise).
+  const char* issue = nullptr;
+};
+
+/// `y = N x` (no r), using ws.dof_a / ws.dof_b when matrix-free. `y` must not alias `x`.
+void multiplyDelassus(const Problem& problem, const Eigen::VectorXd& x, Eigen::VectorXd& y,
+                      Workspace& ws);
+
+/// Unscaled natural map `||gamma - Pi_K(gamma - rho u)||` (impulse units).
+double naturalMap(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u, const Eigen::VectorXd& mu,
+                  double rho);
+
+/// Projects every contact block of `gamma` onto its friction cone, in place.
+void projectOntoCones(Eigen::VectorXd& gamma, const Eigen::VectorXd& mu);
+
+/// Relaxed solve by block PGS. On entry `gamma` is in K; on exit it is the last iterate.
+/// `r` is the free velocity to use (the problem's or the Coulomb-shifted one).
+InnerOutcome runPgs(const Problem& problem, const Eigen::VectorXd& r, const Settings& settings,
+                    const Deadline& deadline, Eigen::VectorXd& gamma, Workspace& ws);
+
+/// Relaxed solve by APGD. On entry `gamma` is in K; on exit it is the best iterate.
+InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Settings& settings,
+                     const Deadline& deadline, Eigen::VectorXd& gamma, Workspace& ws);
+
+}  // namespace rheofeed::ccp::detail
