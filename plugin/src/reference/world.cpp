@@ -553,6 +553,7 @@ double World::mass(BodyId body) const {
 const std::vector<ContactImpulse>& World::contacts() const {
   return impl_->contacts;
 }
+const ccp::Problem& World::lastProblem() const { return impl_->problem; }
 Settings& World::settings() {
   return impl_->settings;
 }
