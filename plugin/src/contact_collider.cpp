@@ -83,11 +83,21 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
   std::size_t next_record = first_record;
   const bool feeder_pair = recorded && (feeders_.contains(o1) || feeders_.contains(o2));
 
+  const bool g2_first = feeders_.options().attach_order == AttachOrder::G2First;
   for (int i = 0; i < n; ++i) {
-    dJointID joint = dJointCreateContact(world_, group_, &contacts[i]);
     dBodyID a = dGeomGetBody(contacts[i].geom.g1);
     dBodyID b = dGeomGetBody(contacts[i].geom.g2);
-    if (feeders_.options().attach_order == AttachOrder::G2First) std::swap(a, b);
+    dJointID joint;
+    if (g2_first) {
+      // ODE's normal points into g1 and the joint pushes its first body along it: attaching
+      // body(g2) first needs the negated normal, or the contact pulls the bodies together.
+      dContact reversed = contacts[i];
+      for (int k = 0; k < 3; ++k) reversed.geom.normal[k] = -reversed.geom.normal[k];
+      joint = dJointCreateContact(world_, group_, &reversed);
+      std::swap(a, b);
+    } else {
+      joint = dJointCreateContact(world_, group_, &contacts[i]);
+    }
     dJointAttach(joint, a, b);
     dJointFeedback* fb = nullptr;
     if (settings_.feedback) {

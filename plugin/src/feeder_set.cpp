@@ -17,6 +17,12 @@ namespace {
 constexpr std::size_t kLinearLookupLimit = 8;
 constexpr int kDiagnosticKinds = 4;
 
+// The body of a contact's geom; 0 for a static geom and for a null geom (a hand-made contact
+// against the static environment: ODE's contact joint never reads the geoms).
+dBodyID bodyOf(dGeomID geom) {
+  return geom ? dGeomGetBody(geom) : nullptr;
+}
+
 std::string geomName(dGeomID geom) {
   std::ostringstream out;
   out << "feeder geom " << static_cast<const void*>(geom);
@@ -302,7 +308,7 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
     // ODE's row order: node0 is the body attached first, unless it is 0 and the other is not.
     dGeomID first = opt.attach_order == AttachOrder::G1First ? g1 : g2;
     dGeomID second = first == g1 ? g2 : g1;
-    dBodyID b_first = dGeomGetBody(first), b_second = dGeomGetBody(second);
+    dBodyID b_first = bodyOf(first), b_second = bodyOf(second);
     if (!b_first && b_second) {
       std::swap(first, second);
       std::swap(b_first, b_second);
@@ -320,11 +326,13 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
       Vec3 value;
       if (!law.finite()) {
         finite = false;
+        ++f->stats.law_not_finite;
         s.report(*f, DiagnosticKind::LawNotFinite, law.problem() + "; contact left undriven");
       } else {
         value = law.tangentialVelocity(p, n);
         if (!isFinite(value)) {
           finite = false;
+          ++f->stats.law_not_finite;
           std::ostringstream out;
           out << "law gave surface velocity (" << value.x << ", " << value.y << ", " << value.z
               << ") at p = (" << p.x << ", " << p.y << ", " << p.z << "), t = " << s.time
@@ -358,11 +366,11 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
     const double speed = finite ? norm(c_rel) : 0.0;
     surf.mode &= ~(dContactMotion2);
     surf.motion2 = 0;
-    if (!finite) ++primary.stats.law_not_finite;
     if (!(speed > opt.min_surface_speed)) {
       surf.mode &= ~(dContactFDir1 | dContactMotion1);
       surf.motion1 = 0;
       ++primary.stats.contacts_undriven;
+      if (f1 && f2) ++f2->stats.contacts_undriven;
     } else {
       const Vec3 t = (1.0 / speed) * c_rel;
       c.fdir1[0] = t.x;
@@ -385,7 +393,8 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
         r.part = feeder_is_g1 ? g2 : g1;
         r.position = p;
         r.normal = n;
-        r.surface_velocity = feeder_is_g1 ? c_g1 - c_g2 : c_g2 - c_g1;
+        // An undriven contact imposes nothing (a non-finite law value never leaves here).
+        if (finite) r.surface_velocity = feeder_is_g1 ? c_g1 - c_g2 : c_g2 - c_g1;
         s.records.push_back(r);
       } catch (...) {
         // Out of memory while recording: observation only, the contact stays driven.
@@ -409,8 +418,8 @@ std::vector<ContactRecord>& FeederSet::records() {
 }
 
 Vec3 FeederSet::slip(const ContactRecord& r) const {
-  const Vec3 v_part = pointVelocity(dGeomGetBody(r.part), r.position);
-  const Vec3 v_feeder = pointVelocity(dGeomGetBody(r.feeder), r.position);
+  const Vec3 v_part = pointVelocity(bodyOf(r.part), r.position);
+  const Vec3 v_feeder = pointVelocity(bodyOf(r.feeder), r.position);
   return tangentialPart(v_part - v_feeder - r.surface_velocity, r.normal);
 }
 

@@ -30,11 +30,17 @@ void requireFinite(const std::string& where, const std::string& what, const Vec3
   requireFinite(where, what + ".z", v.z);
 }
 
-// Returns the name of the first non-finite component of `t`, or empty.
+// Names the first non-finite vector of `t` with its value ("twist.linear = (inf, 0, 0)"), or
+// returns empty.
 std::string firstNonFinite(const Twist& t) {
-  if (!isFinite(t.linear)) return "twist.linear";
-  if (!isFinite(t.angular)) return "twist.angular";
-  if (!isFinite(t.origin)) return "twist.origin";
+  const std::pair<const char*, const Vec3*> parts[] = {
+      {"twist.linear", &t.linear}, {"twist.angular", &t.angular}, {"twist.origin", &t.origin}};
+  for (const auto& [name, v] : parts) {
+    if (isFinite(*v)) continue;
+    std::ostringstream out;
+    out << name << " = (" << v->x << ", " << v->y << ", " << v->z << ")";
+    return out.str();
+  }
   return {};
 }
 
@@ -136,9 +142,15 @@ MotionLaw MotionLaw::belt(const Vec3& direction, double speed, Frame frame) {
   MotionLaw law;
   law.kind_ = Kind::Belt;
   law.frame_ = frame;
-  const double length = norm(direction);
-  law.twist_.linear =
-      (length > 0.0 && std::isfinite(length)) ? (1.0 / length) * direction : direction;
+  // Normalise without squaring the raw components, which under- or overflows for lengths
+  // beyond about 1e+-154. A non-finite or zero direction is kept as given for validate().
+  law.twist_.linear = direction;
+  const double scale =
+      std::fmax(std::fabs(direction.x), std::fmax(std::fabs(direction.y), std::fabs(direction.z)));
+  if (isFinite(direction) && scale > 0.0) {
+    const Vec3 d{direction.x / scale, direction.y / scale, direction.z / scale};
+    law.twist_.linear = (1.0 / norm(d)) * d;
+  }
   law.belt_speed_ = speed;
   return law;
 }
@@ -257,8 +269,11 @@ Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n) const {
       if (length < kBeltEdgeCosine) return {};
       return (w_.x / length) * along;
     }
-    case Eval::Field:
-      return scale_ * tangentialPart((*field_)(p, n, time_), n);
+    case Eval::Field: {
+      const Vec3 c = (*field_)(p, n, time_);
+      if (!isFinite(c)) return c;  // as the field gave it, so a report can name the value
+      return scale_ * tangentialPart(c, n);
+    }
   }
   return {};
 }

@@ -8,7 +8,9 @@
 
 namespace rheofeed {
 
-inline Vec3 toVec3(const dReal* a) { return {a[0], a[1], a[2]}; }
+inline Vec3 toVec3(const dReal* a) {
+  return {a[0], a[1], a[2]};
+}
 
 /// Pose of an ODE body (ODE's dMatrix3 is 3x4 row-major with a padding column).
 inline Pose poseOf(dBodyID body) {

@@ -3,8 +3,8 @@
 /// A ready near callback that does the collision bookkeeping for the application: it collides
 /// geom pairs, lets the application fill the surface parameters, drives feeder contacts through
 /// a FeederSet and creates and attaches the contact joints itself, in ODE's attach order
-/// `dJointAttach(j, dGeomGetBody(g1), dGeomGetBody(g2))` (or the reverse when the FeederSet's
-/// Options::attach_order is G2First).
+/// `dJointAttach(j, dGeomGetBody(g1), dGeomGetBody(g2))` (or the reverse, with the joint's copy
+/// of the normal negated, when the FeederSet's Options::attach_order is G2First).
 ///
 ///     rheofeed::ContactCollider collider(world, feeders);
 ///     collider.setSurfaceCallback([](dGeomID, dGeomID, dContact* c, int n) {

@@ -62,7 +62,7 @@ void requireDoublePrecisionOde();
 /// Which body the application attaches first to its contact joints.
 enum class AttachOrder {
   G1First,  ///< dJointAttach(j, body(g1), body(g2)): ODE's convention (the default).
-  G2First,  ///< dJointAttach(j, body(g2), body(g1)).
+  G2First,  ///< dJointAttach(j, body(g2), body(g1)), the normal negated (ODE's points into g1).
 };
 
 /// What a diagnostic is about.

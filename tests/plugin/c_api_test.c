@@ -1,0 +1,279 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The C API (rheofeed.h) used from a C translation unit: create a feeder set, register a belt,
+ * drive the contacts dCollide makes, step ODE with them, and check the error codes and
+ * messages of bad calls. Returns nonzero if any check fails; every failure is printed.
+ */
+#include <math.h>
+#include <ode/ode.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "rheofeed/rheofeed.h"
+
+static int failures = 0;
+
+#define CHECK(condition)                                                            \
+  do {                                                                              \
+    if (!(condition)) {                                                             \
+      fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #condition); \
+      ++failures;                                                                   \
+    }                                                                               \
+  } while (0)
+
+#define CHECK_NEAR(a, b, tolerance)                                                            \
+  do {                                                                                         \
+    double a_ = (a), b_ = (b);                                                                 \
+    if (!(fabs(a_ - b_) <= (tolerance))) {                                                     \
+      fprintf(stderr, "%s:%d: check failed: %s = %.17g, expected %.17g within %g\n", __FILE__, \
+              __LINE__, #a, a_, b_, (double)(tolerance));                                      \
+      ++failures;                                                                              \
+    }                                                                                          \
+  } while (0)
+
+/* The message contains `part`. */
+#define CHECK_MENTIONS(message, part)                                                        \
+  do {                                                                                       \
+    const char* m_ = (message);                                                              \
+    if (!m_ || !strstr(m_, (part))) {                                                        \
+      fprintf(stderr, "%s:%d: message \"%s\" does not mention \"%s\"\n", __FILE__, __LINE__, \
+              m_ ? m_ : "(null)", (part));                                                   \
+      ++failures;                                                                            \
+    }                                                                                        \
+  } while (0)
+
+/* fdir1 is c / |c| in double precision: unit and orthogonal to the normal up to round-off. */
+#define ROUND_OFF 1e-14
+
+static const double kSpeed = 0.3; /* m/s */
+
+/* A field equal to a belt along +y at 0.2 m/s; counts its calls. */
+static void yField(void* user, const double p[3], const double n[3], double t, double out[3]) {
+  (void)p;
+  (void)n;
+  (void)t;
+  ++*(int*)user;
+  out[0] = 0.0;
+  out[1] = 0.2;
+  out[2] = 0.0;
+}
+
+struct Seen {
+  int count;
+  char kind[64];
+  char message[512];
+};
+
+static void remember(void* user, const char* kind, dGeomID feeder, const char* message) {
+  struct Seen* seen = (struct Seen*)user;
+  (void)feeder;
+  ++seen->count;
+  snprintf(seen->kind, sizeof seen->kind, "%s", kind);
+  snprintf(seen->message, sizeof seen->message, "%s", message);
+}
+
+int main(void) {
+  const double x_axis[3] = {1, 0, 0};
+  const double zero[3] = {0, 0, 0};
+  dWorldID world;
+  dJointGroupID joints;
+  dGeomID belt, part_geom, other, field_geom;
+  dBodyID part;
+  dMass mass;
+  dContact contacts[8];
+  rfFeederSetID set;
+  int n, driven, i, step, field_calls = 0;
+  struct Seen seen;
+
+  dInitODE2(0);
+  world = dWorldCreate();
+  dWorldSetGravity(world, 0, 0, -9.81);
+  joints = dJointGroupCreate(0);
+
+  belt = dCreateBox(0, 2.0, 1.0, 0.1); /* static, top face at z = 0 */
+  dGeomSetPosition(belt, 0, 0, -0.05);
+  part = dBodyCreate(world);
+  dMassSetBoxTotal(&mass, 1.0, 0.1, 0.1, 0.1);
+  dBodySetMass(part, &mass);
+  dBodySetPosition(part, 0, 0, 0.05 - 1e-3); /* 1 mm deep */
+  part_geom = dCreateBox(0, 0.1, 0.1, 0.1);
+  dGeomSetBody(part_geom, part);
+  other = dCreateBox(0, 1, 1, 1);
+  field_geom = dCreateBox(0, 1, 1, 1);
+
+  set = rfFeederSetCreate();
+  CHECK(set != 0);
+  if (!set) return 1;
+
+  /* Register and drive. */
+  CHECK(rfFeederSetAddBelt(set, belt, x_axis, kSpeed, rfFrameWorld) == rfOK);
+  CHECK(strcmp(rfFeederSetGetLastError(set), "") == 0);
+  CHECK(rfFeederSetContains(set, belt) == 1);
+  CHECK(rfFeederSetContains(set, other) == 0);
+  CHECK(rfFeederSetBeginStep(set, 0.0) == rfOK);
+  n = dCollide(belt, part_geom, 8, &contacts[0].geom, sizeof(dContact));
+  CHECK(n == 4); /* a box face on a face: four corners */
+  for (i = 0; i < n; ++i) {
+    memset(&contacts[i].surface, 0, sizeof contacts[i].surface);
+    contacts[i].surface.mu = 0.5;
+  }
+  driven = rfFeederSetDriveContacts(set, contacts, n);
+  CHECK(driven == n);
+  CHECK(rfFeederSetGetContactsDriven(set, belt) == n);
+  for (i = 0; i < driven; ++i) {
+    const dReal* f = contacts[i].fdir1;
+    const dReal* nn = contacts[i].geom.normal;
+    CHECK((contacts[i].surface.mode & dContactFDir1) != 0);
+    CHECK((contacts[i].surface.mode & dContactMotion1) != 0);
+    CHECK((contacts[i].surface.mode & dContactApprox1) == dContactApprox1);
+    CHECK_NEAR(sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]), 1.0, ROUND_OFF);
+    CHECK_NEAR(f[0] * nn[0] + f[1] * nn[1] + f[2] * nn[2], 0.0, ROUND_OFF);
+    /* Static belt: the part is the joint's first body, driven at +V along x. */
+    CHECK_NEAR(contacts[i].surface.motion1 * f[0], kSpeed, ROUND_OFF);
+    CHECK_NEAR(contacts[i].surface.motion1 * f[1], 0.0, ROUND_OFF);
+  }
+
+  /* Step ODE with those contacts: friction mu g h along +x in the first step. */
+  for (i = 0; i < driven; ++i) {
+    dJointID j = dJointCreateContact(world, joints, &contacts[i]);
+    dJointAttach(j, dGeomGetBody(contacts[i].geom.g1), dGeomGetBody(contacts[i].geom.g2));
+  }
+  dWorldStep(world, 0.001);
+  dJointGroupEmpty(joints);
+  CHECK(dBodyGetLinearVel(part)[0] > 0.0);
+  /* ...and on until it is carried at V (V / (mu g) = 0.061 s). */
+  for (step = 1; step < 200; ++step) {
+    CHECK(rfFeederSetBeginStep(set, step * 0.001) == rfOK);
+    n = dCollide(belt, part_geom, 8, &contacts[0].geom, sizeof(dContact));
+    for (i = 0; i < n; ++i) {
+      memset(&contacts[i].surface, 0, sizeof contacts[i].surface);
+      contacts[i].surface.mu = 0.5;
+    }
+    n = rfFeederSetDriveContacts(set, contacts, n);
+    for (i = 0; i < n; ++i) {
+      dJointID j = dJointCreateContact(world, joints, &contacts[i]);
+      dJointAttach(j, dGeomGetBody(contacts[i].geom.g1), dGeomGetBody(contacts[i].geom.g2));
+    }
+    dWorldStep(world, 0.001);
+    dJointGroupEmpty(joints);
+  }
+  CHECK_NEAR(dBodyGetLinearVel(part)[0], kSpeed, 1e-6);
+
+  /* A ramp profile: halfway through, half the speed. */
+  CHECK(rfFeederSetSetRamp(set, belt, 1.0, 2.0, 0.0, 1.0) == rfOK);
+  CHECK(rfFeederSetBeginStep(set, 1.5) == rfOK);
+  n = dCollide(belt, part_geom, 8, &contacts[0].geom, sizeof(dContact));
+  CHECK(n > 0);
+  for (i = 0; i < n; ++i) contacts[i].surface.mu = 0.5;
+  n = rfFeederSetDriveContacts(set, contacts, n);
+  CHECK(n > 0);
+  if (n > 0) CHECK_NEAR(contacts[0].surface.motion1, 0.5 * kSpeed, ROUND_OFF);
+  CHECK(rfFeederSetSetOnOff(set, belt, 5.0, 6.0) == rfOK);
+  CHECK(rfFeederSetBeginStep(set, 1.5) == rfOK);
+  n = dCollide(belt, part_geom, 8, &contacts[0].geom, sizeof(dContact));
+  for (i = 0; i < n; ++i) contacts[i].surface.mu = 0.5;
+  n = rfFeederSetDriveContacts(set, contacts, n);
+  CHECK(n > 0);
+  if (n > 0) {
+    CHECK((contacts[0].surface.mode & dContactMotion1) == 0);
+    CHECK(contacts[0].surface.motion1 == 0.0);
+  }
+
+  /* A C field function, called once per contact. */
+  CHECK(rfFeederSetAddField(set, field_geom, yField, &field_calls, 0) == rfOK);
+  CHECK(rfFeederSetBeginStep(set, 0.0) == rfOK);
+  memset(contacts, 0, sizeof contacts);
+  for (i = 0; i < 3; ++i) {
+    contacts[i].geom.g1 = field_geom;
+    contacts[i].geom.g2 = part_geom;
+    contacts[i].geom.normal[2] = 1.0;
+    contacts[i].surface.mu = 0.5;
+  }
+  CHECK(rfFeederSetDriveContacts(set, contacts, 3) == 3);
+  CHECK(field_calls == 3);
+  CHECK_NEAR(contacts[0].surface.motion1 * contacts[0].fdir1[1], 0.2, ROUND_OFF);
+
+  /* Errors: a NaN speed, named in the message. */
+  CHECK(rfFeederSetAddBelt(set, other, x_axis, NAN, rfFrameWorld) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "belt.speed");
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "nan");
+  CHECK(rfFeederSetContains(set, other) == 0);
+  /* An unregistered geom. */
+  CHECK(rfFeederSetSetBelt(set, other, x_axis, kSpeed, rfFrameWorld) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "not a registered feeder");
+  CHECK(rfFeederSetRemove(set, other) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "not a registered feeder");
+  CHECK(rfFeederSetGetContactsDriven(set, other) == rfErrorInvalidArgument);
+  CHECK(rfFeederSetSetRamp(set, other, 0, 1, 0, 1) == rfErrorInvalidArgument);
+  /* The same geom twice, a bad frame, a null vector, a NaN twist, a NaN time. */
+  CHECK(rfFeederSetAddBelt(set, belt, x_axis, kSpeed, rfFrameWorld) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "already registered");
+  CHECK(rfFeederSetAddBelt(set, other, x_axis, kSpeed, 7) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "frame = 7");
+  CHECK(rfFeederSetAddBelt(set, other, 0, kSpeed, rfFrameWorld) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "direction");
+  {
+    const double bad[3] = {0, INFINITY, 0};
+    CHECK(rfFeederSetAddTwist(set, other, zero, bad, zero, rfFrameWorld) == rfErrorInvalidArgument);
+    CHECK_MENTIONS(rfFeederSetGetLastError(set), "twist.angular.y");
+    CHECK_MENTIONS(rfFeederSetGetLastError(set), "inf");
+  }
+  CHECK(rfFeederSetAddBelt(set, other, x_axis, kSpeed, rfFrameBody) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "Frame::Body");
+  CHECK(rfFeederSetBeginStep(set, NAN) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "time = nan");
+  CHECK(rfFeederSetSetRamp(set, belt, 2.0, 1.0, 0.0, 1.0) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "profile.ramp.t_end");
+  /* A good call clears the message. */
+  CHECK(rfFeederSetBeginStep(set, 0.0) == rfOK);
+  CHECK(strcmp(rfFeederSetGetLastError(set), "") == 0);
+
+  /* Diagnostics: a negative mu on a feeder contact is removed and reported. */
+  memset(&seen, 0, sizeof seen);
+  rfFeederSetSetDiagnosticFunction(set, remember, &seen);
+  memset(contacts, 0, sizeof contacts);
+  contacts[0].geom.g1 = belt;
+  contacts[0].geom.g2 = part_geom;
+  contacts[0].geom.normal[2] = 1.0;
+  contacts[0].surface.mu = -1.0;
+  CHECK(rfFeederSetDriveContacts(set, contacts, 1) == 0);
+  CHECK(seen.count == 1);
+  CHECK(strcmp(seen.kind, "invalid_contact") == 0);
+  CHECK_MENTIONS(seen.message, "mu = -1");
+  rfFeederSetSetDiagnosticFunction(set, 0, 0);
+
+  /* Remove, then it is unknown. */
+  CHECK(rfFeederSetRemove(set, belt) == rfOK);
+  CHECK(rfFeederSetContains(set, belt) == 0);
+
+  /* Null handles and bad options never crash. */
+  CHECK(rfFeederSetBeginStep(0, 0.0) == rfErrorInvalidArgument);
+  CHECK(rfFeederSetDriveContacts(0, contacts, 1) == rfErrorInvalidArgument);
+  CHECK(rfFeederSetContains(0, belt) == 0);
+  CHECK(rfFeederSetGetLastError(0) != 0);
+  CHECK(rfFeederSetCreateWithOptions(1, 5, 1e-9) == 0); /* no such attach order */
+  CHECK(rfFeederSetCreateWithOptions(1, 0, -1.0) == 0); /* negative threshold */
+  CHECK(rfFeederSetCreateWithOptions(1, 0, NAN) == 0);
+  {
+    rfFeederSetID g2_first = rfFeederSetCreateWithOptions(0, rfAttachG2First, 1e-6);
+    CHECK(g2_first != 0);
+    rfFeederSetDestroy(g2_first);
+  }
+  rfFeederSetDestroy(0);
+
+  rfFeederSetDestroy(set);
+  dGeomDestroy(field_geom);
+  dGeomDestroy(other);
+  dGeomDestroy(part_geom);
+  dGeomDestroy(belt);
+  dJointGroupDestroy(joints);
+  dWorldDestroy(world);
+  dCloseODE();
+
+  if (failures) {
+    fprintf(stderr, "c_api_test: %d check(s) failed\n", failures);
+    return 1;
+  }
+  printf("c_api_test: all checks passed\n");
+  return 0;
+}

@@ -1,0 +1,174 @@
+// SPDX-License-Identifier: MIT
+// ContactCollider: the ready near callback. Joint attach order, sub-spaces, the surface
+// callback, and contact forces read back through dJointFeedback.
+#include "rheofeed/contact_collider.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "ode_world.hpp"
+
+namespace rheofeed::test {
+namespace {
+
+constexpr double kStep = 0.001;  // s
+constexpr double kMu = 0.4;
+constexpr double kSpeed = 0.3;   // m/s
+constexpr double kMass = 2.0;    // kg
+constexpr double kLayer = 1e-4;  // m, contact surface layer; parts start at this depth
+
+/// Net contact force (N, world) on `part` from the feedback of the recorded feeder contacts.
+/// The feeder is static, so the part is the joint's only body and its force is f1 + f2 (the
+/// other one is zero whichever slot ODE uses after swapping a 0 first body).
+Vec3 contactForceOnPart(const FeederSet& feeders) {
+  Vec3 sum;
+  for (const ContactRecord& r : feeders.records()) {
+    if (!r.feedback) return {NAN, NAN, NAN};
+    sum = sum + Vec3{r.feedback->f1[0] + r.feedback->f2[0], r.feedback->f1[1] + r.feedback->f2[1],
+                     r.feedback->f1[2] + r.feedback->f2[2]};
+  }
+  return sum;
+}
+
+struct FeedbackScene {
+  FeedbackScene() : w(recording(), withFeedback()) {
+    w.setSurface(dContactApprox1, kMu);
+    dWorldSetContactSurfaceLayer(w.world, kLayer);
+    belt = w.staticBox(4.0, 1.0, 0.1, 0, 0, -0.05);
+    part = w.box(0.1, 0.1, 0.1, kMass, -1.0, 0, 0.05 - kLayer);
+    w.feeders->add(belt, MotionLaw::belt({1, 0, 0}, kSpeed));
+  }
+  static FeederSet::Options recording() {
+    FeederSet::Options o;
+    o.record_contacts = true;
+    return o;
+  }
+  static ContactCollider::Settings withFeedback() {
+    ContactCollider::Settings s;
+    s.feedback = true;
+    return s;
+  }
+  OdeWorld w;
+  dGeomID belt;
+  dBodyID part;
+};
+
+// At rest in contact the step's impulses balance gravity up to the velocity change of the
+// step (~1e-15 m/s here) times m / h, and CFM = 1e-9 compliance.
+constexpr double kForceTolerance = 1e-6;  // N
+
+}  // namespace
+
+TEST(ContactFeedback, SlidingPartFeelsMuMgAlongTheBeltAndMgUp) {
+  FeedbackScene s;
+  s.w.run(0.02, kStep);  // sliding until V / (mu g) = 0.076 s
+  ASSERT_EQ(s.w.feeders->records().size(), 4u);
+  const Vec3 f = contactForceOnPart(*s.w.feeders);
+  // Friction is exactly mu N along fdir1 = +x (the Approx1 bound of row 1), N = m g.
+  EXPECT_NEAR(f.x, kMu * kMass * kGravity, kForceTolerance);
+  EXPECT_NEAR(f.y, 0.0, kForceTolerance);
+  EXPECT_NEAR(f.z, kMass * kGravity, kForceTolerance);
+}
+
+TEST(ContactFeedback, RestingPartCarriedAtBeltSpeedFeelsOnlyMg) {
+  FeedbackScene s;
+  s.w.run(0.5, kStep);  // stuck at V since 0.076 s
+  ASSERT_NEAR(linearVelocity(s.part).x, kSpeed, 1e-7);
+  ASSERT_EQ(s.w.feeders->records().size(), 4u);
+  for (const ContactRecord& r : s.w.feeders->records()) {
+    EXPECT_NE(r.joint, nullptr);
+    EXPECT_EQ(dJointGetType(r.joint), dJointTypeContact);
+  }
+  const Vec3 f = contactForceOnPart(*s.w.feeders);
+  EXPECT_NEAR(f.x, 0.0, kForceTolerance);
+  EXPECT_NEAR(f.y, 0.0, kForceTolerance);
+  EXPECT_NEAR(f.z, kMass * kGravity, kForceTolerance);
+}
+
+TEST(ContactColliderAttach, G2FirstAttachOrderRestsAndCarriesLikeG1First) {
+  // Options::attach_order = G2First makes the collider attach (body(g2), body(g1)). ODE's
+  // normal points into g1 and a contact joint pushes its first body along the normal, so the
+  // joint must get the negated normal; otherwise the contact pulls the part into the belt.
+  BodyState result[2];
+  for (AttachOrder order : {AttachOrder::G1First, AttachOrder::G2First}) {
+    FeederSet::Options options;
+    options.attach_order = order;
+    OdeWorld w(options);
+    w.setSurface(dContactApprox1, kMu);
+    dWorldSetContactSurfaceLayer(w.world, kLayer);
+    dGeomID belt = w.staticBox(4.0, 1.0, 0.1, 0, 0, -0.05);
+    dBodyID part = w.box(0.1, 0.1, 0.1, kMass, 0, 0, 0.05 - kLayer);
+    dGeomID plain = w.staticBox(1.0, 1.0, 0.1, 3.0, 0, -0.05);  // plain ground, no feeder
+    (void)plain;
+    dBodyID resting = w.box(0.1, 0.1, 0.1, kMass, 3.0, 0, 0.05 - kLayer);
+    w.feeders->add(belt, MotionLaw::belt({1, 0, 0}, kSpeed));
+    w.run(0.3, kStep);
+    SCOPED_TRACE(order == AttachOrder::G1First ? "g1 first" : "g2 first");
+    EXPECT_NEAR(position(resting).z, 0.05 - kLayer, 1e-6);
+    EXPECT_NEAR(position(part).z, 0.05 - kLayer, 1e-6);
+    EXPECT_NEAR(linearVelocity(part).x, kSpeed, 1e-7);
+    result[order == AttachOrder::G1First ? 0 : 1] = stateOf(part);
+  }
+  EXPECT_LT(maxDifference(result[0], result[1]), 1e-9);
+}
+
+TEST(ContactColliderSpaces, PartsInASubSpaceAreDrivenToo) {
+  OdeWorld w;
+  w.setSurface(dContactApprox1, kMu);
+  dWorldSetContactSurfaceLayer(w.world, kLayer);
+  dGeomID belt = w.staticBox(4.0, 1.0, 0.1, 0, 0, -0.05);
+  w.feeders->add(belt, MotionLaw::belt({1, 0, 0}, kSpeed));
+  dSpaceID parts = dSimpleSpaceCreate(w.space);
+  dBodyID a = w.box(0.1, 0.1, 0.1, 1.0, -0.5, 0, 0.05 - kLayer);
+  dBodyID b = w.box(0.1, 0.1, 0.1, 1.0, 0.5, 0, 0.05 - kLayer);
+  for (dBodyID body : {a, b}) {
+    dGeomID g = dBodyGetFirstGeom(body);
+    dSpaceRemove(w.space, g);
+    dSpaceAdd(parts, g);
+  }
+  w.run(0.3, kStep);
+  EXPECT_EQ(w.feeders->stats(belt).contacts_driven, 8);
+  EXPECT_EQ(w.collider->contactCount(), 8);
+  EXPECT_NEAR(linearVelocity(a).x, kSpeed, 1e-7);
+  EXPECT_NEAR(linearVelocity(b).x, kSpeed, 1e-7);
+}
+
+TEST(ContactColliderSurface, RejectedPairGetsNoJoints) {
+  OdeWorld w;
+  dGeomID belt = w.staticBox(4.0, 1.0, 0.1, 0, 0, -0.05);
+  w.feeders->add(belt, MotionLaw::belt({1, 0, 0}, kSpeed));
+  dBodyID part = w.box(0.1, 0.1, 0.1, 1.0, 0, 0, 0.05);
+  w.collider->setSurfaceCallback([](dGeomID, dGeomID, dContact*, int) { return false; });
+  w.step(kStep);
+  EXPECT_EQ(w.collider->contactCount(), 0);
+  EXPECT_EQ(w.feeders->stats(belt).contacts_driven, 0);
+  EXPECT_NEAR(linearVelocity(part).z, -kGravity * kStep, 1e-12);  // free fall
+}
+
+TEST(ContactColliderSurface, DefaultSurfaceIsApprox1WithMuHalf) {
+  // No callback: mu = 0.5 as a coefficient, so a sliding part accelerates at 0.5 g.
+  OdeWorld w;
+  dWorldSetContactSurfaceLayer(w.world, kLayer);
+  w.collider->setSurfaceCallback(nullptr);
+  dGeomID belt = w.staticBox(4.0, 1.0, 0.1, 0, 0, -0.05);
+  w.feeders->add(belt, MotionLaw::belt({1, 0, 0}, kSpeed));
+  dBodyID part = w.box(0.1, 0.1, 0.1, 3.0, 0, 0, 0.05 - kLayer);
+  w.run(0.02, kStep);
+  EXPECT_NEAR(linearVelocity(part).x, 0.5 * kGravity * 0.02, 1e-9);
+}
+
+TEST(ContactColliderJoints, ConnectedBodiesDoNotCollide) {
+  OdeWorld w;
+  dBodyID a = w.box(0.1, 0.1, 0.1, 1.0, 0, 0, 1.0);
+  dBodyID b = w.box(0.1, 0.1, 0.1, 1.0, 0.05, 0, 1.0);  // overlapping
+  dJointID hinge = dJointCreateHinge(w.world, nullptr);
+  dJointAttach(hinge, a, b);
+  w.collider->collide(w.space, 0.0);
+  EXPECT_EQ(w.collider->contactCount(), 0);
+  dJointDestroy(hinge);
+  w.collider->collide(w.space, 0.0);
+  EXPECT_GT(w.collider->contactCount(), 0);
+}
+
+}  // namespace rheofeed::test
