@@ -79,6 +79,7 @@ constexpr double kMinSurfaceSpeed = 1e-12;
 struct World::Impl {
   struct Body {
     bool kinematic = false;
+    bool disabled = false;  // taken out of the simulation: no motion, no contacts
     double mass = 0;
     Matrix3d inv_inertia_body = Matrix3d::Zero();
     Matrix3d inertia_body = Matrix3d::Zero();
@@ -231,6 +232,9 @@ World::World(const Settings& settings) : impl_(std::make_unique<Impl>()) {
   if (std::string bad = settingsProblem(settings); !bad.empty()) refuse(bad);
   impl_->settings = settings;
   impl_->solver.settings() = settings.solver;
+  // ODE's collision module must be initialised once per process before any geom is used.
+  static const bool ode_initialised = (dInitODE2(0), true);
+  (void)ode_initialised;
   impl_->space = dHashSpaceCreate(nullptr);
 }
 
@@ -371,6 +375,10 @@ StepReport World::step(double h) {
   for (std::size_t k = 0; k < s.bodies.size(); ++k) {
     Impl::Body& b = s.bodies[k];
     if (b.kinematic) continue;
+    if (b.disabled) {
+      v_free.segment<6>(b.dof).setZero();
+      continue;
+    }
     const Matrix3d r = s.rotation(static_cast<BodyId>(k));
     const Matrix3d i_world = r * b.inertia_body * r.transpose();
     inv_inertia_world[k] = r * b.inv_inertia_body * r.transpose();
@@ -477,6 +485,17 @@ StepReport World::step(double h) {
     }
     s.solver.settings() = cfg.solver;
     report.solve = s.solver.solve(problem, gamma);
+    if (cfg.solver.coulomb_outer_iterations > 0 &&
+        report.solve.status == ccp::Status::MaxIterations) {
+      // The true-Coulomb fixed point is not a convex problem and may fail to settle (impacts
+      // in a falling pile); its last iterate can then be far from any physical answer. Fall
+      // back to the relaxed CCP for this step, which always has a unique u.
+      ccp::Settings relaxed = cfg.solver;
+      relaxed.coulomb_outer_iterations = 0;
+      s.solver.settings() = relaxed;
+      report.solve = s.solver.solve(problem, gamma);
+      report.coulomb_fallback = true;
+    }
     if (report.solve.status == ccp::Status::InvalidInput) {
       refuse("step: the contact problem was refused: " + report.solve.message);
     }
@@ -514,6 +533,7 @@ StepReport World::step(double h) {
       b.state.orientation = toQuat(Eigen::Quaterniond(rotationOf(next_pose[k])).normalized());
       continue;
     }
+    if (b.disabled) continue;
     const Vector3d v = v_next.segment<3>(b.dof), w = v_next.segment<3>(b.dof + 3);
     b.state.linear_velocity = toVec3(v);
     b.state.angular_velocity = toVec3(w);
@@ -532,6 +552,19 @@ StepReport World::step(double h) {
   }
   s.time += h;
   return report;
+}
+
+void World::disableBody(BodyId body) {
+  if (body < 0 || body >= numBodies() || impl_->bodies[body].kinematic) {
+    refuse("disableBody: " + std::to_string(body) + " is not a dynamic body");
+  }
+  Impl::Body& b = impl_->bodies[body];
+  b.disabled = true;
+  b.state.linear_velocity = {};
+  b.state.angular_velocity = {};
+  for (auto& [geom, a] : impl_->attached) {
+    if (a.body == body) dGeomDisable(geom);
+  }
 }
 
 double World::time() const {
@@ -553,7 +586,9 @@ double World::mass(BodyId body) const {
 const std::vector<ContactImpulse>& World::contacts() const {
   return impl_->contacts;
 }
-const ccp::Problem& World::lastProblem() const { return impl_->problem; }
+const ccp::Problem& World::lastProblem() const {
+  return impl_->problem;
+}
 Settings& World::settings() {
   return impl_->settings;
 }

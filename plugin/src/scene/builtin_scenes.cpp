@@ -167,4 +167,103 @@ Scene pileOnBeltScene(int count, double speed) {
   return s;
 }
 
+Scene vibratingTrackScene(double amplitude, double frequency, double angle, int parts) {
+  Scene s;
+  s.name = "vibrating_track";
+  Pose pose;
+  pose.position = {0, 0, -0.025};
+  Fixture track = boxFixture("track", {2.0, 0.2, 0.05}, pose);
+  track.law.kind = FeederLaw::Kind::Vibration;
+  track.law.vibration.amplitude = amplitude;
+  track.law.vibration.frequency = frequency;
+  track.law.vibration.direction = {std::cos(angle), 0, std::sin(angle)};
+  s.fixtures.push_back(track);
+  PartSpec p;
+  p.name = "plates";
+  p.shape = Shape::Kind::Box;
+  p.size[0].mean = 0.02;
+  p.size[1].mean = 0.02;
+  p.size[2].mean = 0.005;
+  p.density = 7800;
+  // One row of parts along y (they drift along x, side by side, never touching).
+  p.spawn_min = {-0.5, -0.09, 0.0025};
+  p.spawn_max = {-0.5, 0.09, 0.0025};
+  p.count = parts;
+  s.parts.push_back(p);
+  s.material.mu = 0.4;
+  s.solver.time_step = 1.0 / (200 * frequency);
+  s.solver.iterations = 50;
+  s.solver.ode_quickstep = false;
+  s.duration = 2.0;
+  s.outputs.warmup = 0.5;
+  s.outputs.sample_interval = 10.0 / frequency;
+  return s;
+}
+
+Scene linearTroughScene(int count, double rate, double amplitude, double frequency, double angle) {
+  Scene s;
+  s.name = "linear_trough";
+  Fixture trough;
+  trough.name = "trough";
+  auto add = [&](Fixture& f, const Vec3& size, const Vec3& at) {
+    Fixture::Geom g;
+    g.shape.kind = Shape::Kind::Box;
+    g.shape.size = size;
+    g.pose.position = at;
+    f.geoms.push_back(g);
+  };
+  add(trough, {0.7, 0.12, 0.02}, {0.25, 0, -0.01});     // base, x from -0.1 to 0.6
+  add(trough, {0.7, 0.01, 0.06}, {0.25, 0.065, 0.02});  // side walls
+  add(trough, {0.7, 0.01, 0.06}, {0.25, -0.065, 0.02});
+  add(trough, {0.01, 0.14, 0.06}, {-0.105, 0, 0.02});  // back wall
+  trough.law.kind = FeederLaw::Kind::Vibration;
+  trough.law.vibration.amplitude = amplitude;
+  trough.law.vibration.frequency = frequency;
+  trough.law.vibration.direction = {std::cos(angle), 0, std::sin(angle)};
+  s.fixtures.push_back(trough);
+
+  Fixture hopper;  // static walls of a square hopper above the trough start
+  hopper.name = "hopper";
+  add(hopper, {0.01, 0.12, 0.15}, {-0.09, 0, 0.135});
+  add(hopper, {0.01, 0.12, 0.15}, {0.11, 0, 0.135});
+  add(hopper, {0.2, 0.01, 0.15}, {0.01, 0.065, 0.135});
+  add(hopper, {0.2, 0.01, 0.15}, {0.01, -0.065, 0.135});
+  s.fixtures.push_back(hopper);
+
+  Fixture floor;  // catches the parts that leave the trough
+  floor.name = "floor";
+  add(floor, {1.0, 1.0, 0.02}, {1.0, 0, -0.3});
+  s.fixtures.push_back(floor);
+
+  PartSpec p;
+  p.name = "boxes";
+  p.shape = Shape::Kind::Box;
+  for (auto& d : p.size) {
+    d.mean = 0.015;
+    d.stddev = 0.0022;
+    d.min = 0.008;
+    d.max = 0.025;
+  }
+  p.size[2].mean = 0.008;
+  p.size[2].stddev = 0.001;
+  p.size[2].min = 0.005;
+  p.density = 2700;
+  p.spawn_min = {-0.05, -0.03, 0.12};  // inside the hopper with room for a turned part
+  p.spawn_max = {0.07, 0.03, 0.18};
+  p.random_orientation = true;
+  p.count = count;
+  p.rate = rate;
+  s.parts.push_back(p);
+  s.material.mu = 0.4;
+  s.solver.time_step = 1.0 / (200 * frequency);
+  s.solver.iterations = 30;
+  s.duration = 6.0;
+  s.outputs.warmup = 2.0;
+  s.outputs.sample_interval = 10.0 / frequency;
+  s.outputs.exit_plane = true;
+  s.outputs.exit_point = {0.6, 0, 0};
+  s.outputs.exit_normal = {1, 0, 0};
+  return s;
+}
+
 }  // namespace rheofeed::scene

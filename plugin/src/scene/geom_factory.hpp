@@ -5,13 +5,44 @@
 
 #include <ode/ode.h>
 
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
 #include "rheofeed/scene/scene.hpp"
 
 namespace rheofeed::scene {
 
+/// Owns the ODE triangle-mesh data (dTriMeshDataID) of the mesh geoms built with it. ODE keeps
+/// pointers into that data and into the vertex and index arrays it was built from, so the store
+/// keeps the TriangleMesh alive and must outlive every geom made with it: a simulation destroys
+/// its space (and with it the geoms) before the store. One data object per TriangleMesh, shared
+/// by every geom of that mesh (all parts drawn at the same scale share one).
+class TriMeshStore {
+ public:
+  TriMeshStore() = default;
+  ~TriMeshStore();
+  TriMeshStore(const TriMeshStore&) = delete;
+  TriMeshStore& operator=(const TriMeshStore&) = delete;
+
+  /// The ODE data of `mesh` (built on first use). Throws std::invalid_argument for a mesh with
+  /// no triangles, bad indices or non-finite coordinates.
+  dTriMeshDataID data(const std::shared_ptr<const TriangleMesh>& mesh);
+
+ private:
+  struct Entry {
+    std::shared_ptr<const TriangleMesh> mesh;  // vertices are read in place by ODE
+    std::vector<dTriIndex> indices;
+    dTriMeshDataID id = nullptr;
+  };
+  std::unordered_map<const TriangleMesh*, std::unique_ptr<Entry>> entries_;
+};
+
 /// Creates the geom of `shape` in `space` (no body, identity pose). Planes use their world
-/// equation. Meshes need a loaded mesh: throws std::invalid_argument (not supported here).
-dGeomID createGeom(dSpaceID space, const Shape& shape);
+/// equation. Meshes are built from shape.mesh_data (already scaled; filled by the scene loader)
+/// with their ODE data owned by `meshes`; a mesh shape without mesh_data throws
+/// std::invalid_argument.
+dGeomID createGeom(dSpaceID space, const Shape& shape, TriMeshStore& meshes);
 
 /// Sets a placeable geom's world pose.
 void setGeomPose(dGeomID geom, const Pose& pose);

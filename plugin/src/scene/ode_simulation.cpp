@@ -29,6 +29,7 @@ class OdeSimulation final : public Simulation {
     dWorldSetERP(world_, scene.solver.erp);
     dWorldSetCFM(world_, scene.solver.cfm);
     dWorldSetQuickStepNumIterations(world_, scene.solver.iterations);
+    dWorldSetContactMaxCorrectingVel(world_, scene.solver.max_correcting_velocity);
     space_ = dHashSpaceCreate(nullptr);
     feeders_ = std::make_unique<FeederSet>();
 
@@ -41,7 +42,7 @@ class OdeSimulation final : public Simulation {
         vibrating_.push_back({body, f.law.vibration});
       }
       for (const Fixture::Geom& g : f.geoms) {
-        dGeomID geom = createGeom(space_, g.shape);
+        dGeomID geom = createGeom(space_, g.shape, meshes_);
         if (g.shape.kind != Shape::Kind::Plane) setGeomPose(geom, g.pose);
         if (body) {
           dGeomSetBody(geom, body);
@@ -89,6 +90,16 @@ class OdeSimulation final : public Simulation {
       dWorldStep(world_, h);
     }
     time_ = ++steps_ * h;
+    for (std::size_t i = 0; i < parts_.size(); ++i) {
+      if (!active_[i]) continue;
+      const Vec3 x = vec(dBodyGetPosition(parts_[i]));
+      checkPart(static_cast<int>(i), x, method_, time_);
+      if (x.z < scene_.removal_height) {  // left the scene: out of the simulation for good
+        dBodyDisable(parts_[i]);
+        dGeomDisable(dBodyGetFirstGeom(parts_[i]));
+        active_[i] = false;
+      }
+    }
     collectTotals(h);
     spawnDue();
   }
@@ -98,6 +109,7 @@ class OdeSimulation final : public Simulation {
   PartState part(int i) const override {
     dBodyID b = parts_.at(static_cast<std::size_t>(i));
     PartState s;
+    s.active = active_.at(static_cast<std::size_t>(i));
     s.position = vec(dBodyGetPosition(b));
     s.velocity = vec(dBodyGetLinearVel(b));
     s.angular_velocity = vec(dBodyGetAngularVel(b));
@@ -146,8 +158,9 @@ class OdeSimulation final : public Simulation {
       toOdeMatrix(p.pose, r);
       dBodySetRotation(b, r);
       dBodySetLinearVel(b, p.velocity.x, p.velocity.y, p.velocity.z);
-      dGeomSetBody(createGeom(space_, p.shape), b);
+      dGeomSetBody(createGeom(space_, p.shape, meshes_), b);
       parts_.push_back(b);
+      active_.push_back(true);
     }
   }
 
@@ -172,6 +185,7 @@ class OdeSimulation final : public Simulation {
   Method method_;
   std::vector<PartInstance> instances_;
   std::size_t next_ = 0;
+  TriMeshStore meshes_;  // trimesh data of the mesh geoms; outlives space_ (see the destructor)
   dWorldID world_;
   dSpaceID space_;
   std::unique_ptr<FeederSet> feeders_;
@@ -179,6 +193,7 @@ class OdeSimulation final : public Simulation {
   std::vector<std::pair<dBodyID, Vibration>> vibrating_;
   std::unordered_set<dGeomID> fixture_geoms_;
   std::vector<dBodyID> parts_;
+  std::vector<bool> active_;
   double time_ = 0;
   long steps_ = 0;
   ContactTotals totals_;

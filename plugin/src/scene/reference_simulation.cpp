@@ -24,6 +24,8 @@ class ReferenceSimulation final : public Simulation {
     s.solver.method = scene.solver.apgd ? ccp::Method::Apgd : ccp::Method::Pgs;
     s.solver.max_iterations = scene.solver.iterations;
     s.solver.tolerance = scene.solver.tolerance;
+    s.solver.coulomb_outer_iterations = scene.solver.coulomb_iterations;
+    s.max_correcting_velocity = scene.solver.max_correcting_velocity;
     world_ = std::make_unique<reference::World>(s);
 
     for (const Fixture& f : scene.fixtures) {
@@ -34,7 +36,7 @@ class ReferenceSimulation final : public Simulation {
         body = world_->addKinematicBody([v](double t) { return v.displacement(t); });
       }
       for (const Fixture::Geom& g : f.geoms) {
-        dGeomID geom = createGeom(world_->space(), g.shape);
+        dGeomID geom = createGeom(world_->space(), g.shape, meshes_);
         if (g.shape.kind != Shape::Kind::Plane) setGeomPose(geom, g.pose);
         if (body != reference::kStatic) {
           world_->attachGeom(geom, body, g.pose);  // the body's rest pose is the identity
@@ -51,6 +53,15 @@ class ReferenceSimulation final : public Simulation {
     const double h = scene_.solver.time_step;
     world_->step(h);
     time_ = ++steps_ * h;
+    for (std::size_t i = 0; i < parts_.size(); ++i) {
+      if (!active_[i]) continue;
+      const Vec3 x = world_->state(parts_[i]).position;
+      checkPart(static_cast<int>(i), x, method_, time_);
+      if (x.z < scene_.removal_height) {
+        world_->disableBody(parts_[i]);
+        active_[i] = false;
+      }
+    }
     collectTotals();
     spawnDue();
   }
@@ -60,6 +71,7 @@ class ReferenceSimulation final : public Simulation {
   PartState part(int i) const override {
     const reference::BodyState& b = world_->state(parts_.at(static_cast<std::size_t>(i)));
     PartState s;
+    s.active = active_.at(static_cast<std::size_t>(i));
     s.position = b.position;
     s.velocity = b.linear_velocity;
     s.angular_velocity = b.angular_velocity;
@@ -89,8 +101,9 @@ class ReferenceSimulation final : public Simulation {
       state.linear_velocity = p.velocity;
       state.orientation = quatOf(p.pose);
       const BodyId body = world_->addBody(p.mass, p.inertia, state);
-      world_->attachGeom(createGeom(world_->space(), p.shape), body);
+      world_->attachGeom(createGeom(world_->space(), p.shape, meshes_), body);
       parts_.push_back(body);
+      active_.push_back(true);
     }
   }
 
@@ -132,9 +145,11 @@ class ReferenceSimulation final : public Simulation {
   Method method_;
   std::vector<PartInstance> instances_;
   std::size_t next_ = 0;
+  TriMeshStore meshes_;  // declared before world_: destroyed after the world's space and geoms
   std::unique_ptr<reference::World> world_;
   std::unordered_set<dGeomID> fixture_geoms_;
   std::vector<BodyId> parts_;
+  std::vector<bool> active_;
   double time_ = 0;
   long steps_ = 0;
   ContactTotals totals_;

@@ -5,9 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
 #include <sstream>
 #include <stdexcept>
+
+#include "rheofeed/scene/mesh.hpp"
 
 namespace rheofeed::scene {
 namespace {
@@ -141,6 +144,11 @@ void Scene::validate() const {
   if (solver.iterations < 1) bad("solver.iterations", solver.iterations, "must be >= 1");
   if (!(solver.erp >= 0 && solver.erp <= 1)) bad("solver.erp", solver.erp, "must be in [0, 1]");
   nonNegative("solver.cfm", solver.cfm);
+  positive("solver.max_correcting_velocity", solver.max_correcting_velocity);
+  finite("removal_height", removal_height);
+  if (solver.coulomb_iterations < 0) {
+    bad("solver.coulomb_iterations", solver.coulomb_iterations, "must be >= 0");
+  }
   positive("solver.tolerance", solver.tolerance);
   nonNegative("material.mu", material.mu);
   if (!(material.restitution >= 0 && material.restitution <= 1)) {
@@ -149,6 +157,10 @@ void Scene::validate() const {
   unit("outputs.conveying_direction", outputs.conveying_direction);
   positive("outputs.sample_interval", outputs.sample_interval);
   nonNegative("outputs.warmup", outputs.warmup);
+  if (outputs.angular_drift) {
+    finite("outputs.axis_origin", outputs.axis_origin);
+    unit("outputs.axis_direction", outputs.axis_direction);
+  }
   if (outputs.exit_plane) {
     finite("outputs.exit_point", outputs.exit_point);
     unit("outputs.exit_normal", outputs.exit_normal);
@@ -277,6 +289,18 @@ std::vector<PartInstance> drawParts(const Scene& scene) {
   std::vector<std::pair<Vec3, double>> placed;  // t = 0 parts: centre and bounding radius
   for (std::size_t s = 0; s < scene.parts.size(); ++s) {
     const PartSpec& spec = scene.parts[s];
+    // Mesh parts: mass properties at scale 1 (mesh.hpp), and one scaled mesh per drawn scale.
+    MassProperties unit_mesh;
+    double unit_radius = 0;
+    std::map<double, std::shared_ptr<const TriangleMesh>> scaled_meshes;
+    if (spec.shape == Shape::Kind::Mesh) {
+      if (!spec.mesh_data) {
+        throw std::invalid_argument("parts[" + std::to_string(s) + "].mesh: '" + spec.mesh +
+                                    "' is not loaded (use loadScene or loadSceneMeshes)");
+      }
+      unit_mesh = massProperties(*spec.mesh_data, spec.density);
+      unit_radius = boundingRadius(*spec.mesh_data);
+    }
     for (int i = 0; i < spec.count; ++i) {
       PartInstance p;
       p.spec = static_cast<int>(s);
@@ -306,6 +330,20 @@ std::vector<PartInstance> drawParts(const Scene& scene) {
           dMassSetCapsule(&m, spec.density, 3, p.shape.radius, p.shape.length);
           bound = p.shape.radius + 0.5 * p.shape.length;
           break;
+        case Shape::Kind::Mesh: {
+          // size[0] scales the mesh (centred on its centre of mass): m ~ s^3, I ~ s^5.
+          const double scale = draw(spec.size[0]);
+          std::shared_ptr<const TriangleMesh>& mesh = scaled_meshes[scale];
+          if (!mesh) mesh = std::make_shared<const TriangleMesh>(scaleMesh(*spec.mesh_data, scale));
+          p.shape.mesh = spec.mesh;
+          p.shape.mesh_scale = scale;
+          p.shape.mesh_data = mesh;
+          const MassProperties mp = scaleMassProperties(unit_mesh, scale);
+          const double* in = mp.inertia;
+          dMassSetParameters(&m, mp.mass, 0, 0, 0, in[0], in[4], in[8], in[1], in[2], in[5]);
+          bound = scale * unit_radius;
+          break;
+        }
         default:
           throw std::invalid_argument("parts[" + std::to_string(s) + "].shape: " +
                                       toString(spec.shape) + " parts are not supported here");

@@ -2,6 +2,9 @@
 #include "rheofeed/scene/simulation.hpp"
 
 #include <Eigen/Geometry>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
 
 #include "simulation_internal.hpp"
 
@@ -18,6 +21,20 @@ Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h) {
   const Eigen::AngleAxisd rel(r1 * r0.transpose());
   const Eigen::Vector3d w = rel.axis() * (rel.angle() / h);
   return {w.x(), w.y(), w.z()};
+}
+
+void checkPart(int index, const Vec3& x, Method method, double time) {
+  constexpr double kSceneRadius = 1e4;  // m: nothing in a feeder scene gets this far
+  if (isFinite(x) && std::abs(x.x) < kSceneRadius && std::abs(x.y) < kSceneRadius &&
+      std::abs(x.z) < kSceneRadius) {
+    return;
+  }
+  std::ostringstream out;
+  out << toString(method) << ": part " << index << " is at (" << x.x << ", " << x.y << ", " << x.z
+      << ") m at t = " << time
+      << " s: the step is unstable (reduce solver.time_step, raise solver.iterations, or check "
+         "for parts spawned inside fixtures)";
+  throw std::runtime_error(out.str());
 }
 
 std::unique_ptr<Simulation> makeSimulation(const Scene& scene, Method method) {

@@ -100,6 +100,9 @@ using FrictionCallback = std::function<double(dGeomID g1, dGeomID g2)>;
 struct StepReport {
   int contacts = 0;
   ccp::Result solve;  ///< the solver's result (status, iterations, residuals, time)
+  /// True when the true-Coulomb fixed point (Settings::solver.coulomb_outer_iterations > 0)
+  /// did not settle and the step used the relaxed CCP instead.
+  bool coulomb_fallback = false;
 };
 
 /// The reference world. Geoms are created by the caller in space() without ODE bodies and then
@@ -137,6 +140,10 @@ class World {
   /// Advance by h (s). Throws std::invalid_argument if h is not finite and > 0. A solver that
   /// does not converge is reported in the StepReport (status), not thrown.
   StepReport step(double h);
+
+  /// Take a dynamic body out of the simulation for good: it stops where it is and its geoms
+  /// no longer collide (for parts that left the scene). Throws for a non-dynamic body.
+  void disableBody(BodyId body);
 
   double time() const;
   int numBodies() const;

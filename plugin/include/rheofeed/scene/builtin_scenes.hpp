@@ -28,4 +28,20 @@ Scene helicalRampScene(double omega);
 /// `count` boxes (4 cm, 10 % size spread) dropped in a pile on the belt of beltScene.
 Scene pileOnBeltScene(int count = 50, double speed = 0.3);
 
+/// A straight horizontal track (static box, top at z = 0, along +x) vibrating at `frequency`
+/// (Hz) with peak amplitude `amplitude` (m) at `angle` (rad) to the track, in the x-z plane;
+/// `parts` flat boxes (20 x 20 x 5 mm, steel) spread along it, far enough apart not to touch;
+/// mu = 0.4. Time step 1/(200 f); 2 s with 0.5 s warm-up; conveying direction +x.
+Scene vibratingTrackScene(double amplitude = 0.2e-3, double frequency = 50, double angle = 0.349066,
+                          int parts = 1);
+
+/// A linear vibratory trough (base 0.7 m x 0.12 m with side walls, along +x, top of the base at
+/// z = 0) fed by a hopper at its start: boxes with normally distributed sizes (mean 15 mm,
+/// 15 % spread) spawned at `rate` parts/s up to `count`; the trough vibrates at `frequency`
+/// (Hz), `amplitude` (m, peak) at `angle` (rad) to the track (defaults: 50 Hz, 0.25 mm, 30 deg:
+/// throw number 1.26, mild hopping, as industrial feeders run); an exit plane at its end, x = 0.6
+/// m; a catch floor below the end.
+Scene linearTroughScene(int count = 60, double rate = 20, double amplitude = 0.25e-3,
+                        double frequency = 50, double angle = 0.523599);
+
 }  // namespace rheofeed::scene

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,13 @@
 #include "rheofeed/vec3.hpp"
 
 namespace rheofeed::scene {
+
+/// A triangle mesh in its own frame (m): vertices and counter-clockwise (outward) triangles.
+struct TriangleMesh {
+  std::vector<double> vertices;  ///< x, y, z per vertex (m)
+  std::vector<int> triangles;    ///< three vertex indices per triangle
+  std::string source;            ///< where it came from (file path), for messages
+};
 
 /// A collision shape. Sizes in metres; cylinders and capsules lie along their local z axis.
 struct Shape {
@@ -30,6 +38,9 @@ struct Shape {
   double plane_offset = 0;
   std::string mesh;         ///< Mesh: file path (any format assimp reads)
   double mesh_scale = 1.0;  ///< Mesh: scale applied to the file's coordinates
+  /// Mesh: the loaded triangles (already scaled), filled by the scene loader (scene_io.hpp);
+  /// geoms are built from it, so a scene without meshes never loads any.
+  std::shared_ptr<const TriangleMesh> mesh_data;
 };
 
 /// Printable name of a shape kind ("box", "sphere", ...).
@@ -96,7 +107,9 @@ struct PartSpec {
   std::string name = "parts";
   Shape::Kind shape = Shape::Kind::Box;
   Distribution size[3];  ///< Box: x, y, z edges; Sphere: [0] radius; Cyl/Capsule: [0] r, [1] length
-  std::string mesh;      ///< Mesh parts: file (assimp); size[0] scales it
+  std::string mesh;      ///< Mesh parts: file (assimp); size[0] is the scale factor
+  /// Mesh parts: loaded triangles at scale 1, centred on their centre of mass (scene loader).
+  std::shared_ptr<const TriangleMesh> mesh_data;
   double density = 7800;      ///< (kg/m^3)
   Vec3 spawn_min, spawn_max;  ///< spawn region, axis-aligned box (m, world)
   bool random_orientation = false;
@@ -120,6 +133,14 @@ struct SolverSettings {
   double cfm = 1e-5;          ///< ODE and reference (ODE's units)
   double tolerance = 1e-6;    ///< CCP residual tolerance
   bool apgd = true;           ///< CCP: APGD (true) or PGS
+  /// Reference solver: outer fixed-point iterations of the true Coulomb law (>= 0). 0 solves
+  /// the relaxed CCP, whose sliding contacts separate at mu |u_t| (parts hop off a sliding
+  /// surface: +16 % slip at 400 steps per cycle on a vibrated plate, tests/reference).
+  int coulomb_iterations = 10;
+  /// Cap on the speed at which a penetration is pushed out (m/s, > 0), ODE's
+  /// dWorldSetContactMaxCorrectingVel, mirrored by the reference. Without it ERP depth / h
+  /// becomes a launch speed at small h (0.2 x 5 mm / 0.1 ms = 10 m/s).
+  double max_correcting_velocity = 0.5;
 };
 
 /// The four methods.
@@ -135,7 +156,12 @@ bool isFullVibration(Method method);
 /// What to measure.
 struct Outputs {
   Vec3 conveying_direction{1, 0, 0};  ///< unit direction of the drift metric
-  bool exit_plane = false;            ///< count parts crossing the plane
+  /// Measure the drift as an angular velocity (rad/s) about an axis (bowls, turntables)
+  /// instead of a velocity along conveying_direction.
+  bool angular_drift = false;
+  Vec3 axis_origin{0, 0, 0};     ///< a point of the drift axis (m)
+  Vec3 axis_direction{0, 0, 1};  ///< unit drift axis; positive drift turns by the right hand
+  bool exit_plane = false;       ///< count parts crossing the plane
   Vec3 exit_point, exit_normal{1, 0, 0};
   double sample_interval = 0.01;  ///< (s) metric sampling period
   double warmup = 0.0;            ///< (s) excluded from the mean drift
@@ -148,6 +174,9 @@ struct Scene {
   std::vector<PartSpec> parts;
   Material material;
   SolverSettings solver;
+  /// Parts that fall below this height (m) have left the scene: they are removed from the
+  /// simulation (no more contacts or motion) and from the drift metrics.
+  double removal_height = -2.0;
   double duration = 1.0;  ///< (s)
   std::uint64_t seed = 1;
   Outputs outputs;

@@ -18,6 +18,9 @@ struct PartState {
   Vec3 velocity;                                     ///< (m/s)
   Vec3 angular_velocity;                             ///< (rad/s)
   double rotation[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< body to world, row-major
+  /// False once the part fell below Scene::removal_height and was taken out of the simulation
+  /// (its state is then frozen where it was removed).
+  bool active = true;
 };
 
 /// Contact totals of the last step: sums over all contacts.
@@ -30,7 +33,10 @@ struct ContactTotals {
 class Simulation {
  public:
   virtual ~Simulation() = default;
-  /// Advance one time step of scene.solver.time_step (s), spawning the parts that are due.
+  /// Advance one time step of scene.solver.time_step (s), spawning the parts that are due and
+  /// removing those below Scene::removal_height. Throws std::runtime_error naming the part if
+  /// a part's state becomes non-finite or flies out of the scene (|x| > 1e4 m), which only an
+  /// unstable step causes, before the collision engine sees it.
   virtual void step() = 0;
   /// Simulated time (s).
   virtual double time() const = 0;

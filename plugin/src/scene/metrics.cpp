@@ -1,0 +1,259 @@
+// SPDX-License-Identifier: MIT
+#include "rheofeed/scene/metrics.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <sstream>
+
+#include "rheofeed/scene/output.hpp"
+#include "rheofeed/scene/plot.hpp"
+
+namespace rheofeed::scene {
+namespace {
+
+struct Track {
+  double angle = 0;   // last angle about the drift axis (rad), for unwrapping
+  double turned = 0;  // unwrapped angle since spawn (rad)
+  double previous_turned = 0, start_turned = 0, end_turned = 0;
+  Vec3 spawn;     // position when first seen (m)
+  Vec3 previous;  // position at the previous sample (m)
+  bool has_previous = false;
+  Vec3 start;  // position when drift measurement started (m)
+  double start_time = -1;
+  Vec3 end;  // position when it stopped (exit or run end)
+  double end_time = -1;
+  bool exited = false;
+};
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Angle of p about the axis (origin o, unit direction k) in a frame fixed to the axis.
+double angleAbout(const Vec3& p, const Vec3& o, const Vec3& k) {
+  Vec3 e1 = std::abs(k.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  e1 = tangentialPart(e1, k);
+  e1 = (1.0 / norm(e1)) * e1;
+  const Vec3 r = p - o;
+  return std::atan2(dot(r, cross(k, e1)), dot(r, e1));
+}
+
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0 : s / v.size();
+}
+
+double ci95(const std::vector<double>& v) {
+  if (v.size() < 2) return 0;
+  const double m = mean(v);
+  double ss = 0;
+  for (double x : v) ss += (x - m) * (x - m);
+  const double sd = std::sqrt(ss / (v.size() - 1));
+  return studentT95(static_cast<int>(v.size()) - 1) * sd / std::sqrt(double(v.size()));
+}
+
+}  // namespace
+
+double studentT95(int dof) {
+  // Two-sided 95 % quantiles of Student's t.
+  static const double table[] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306,
+                                 2.262,  2.228, 2.201, 2.179, 2.160, 2.145, 2.131, 2.120,
+                                 2.110,  2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064,
+                                 2.060,  2.056, 2.052, 2.048, 2.045, 2.042};
+  if (dof < 1) return 0;
+  if (dof <= 30) return table[dof - 1];
+  if (dof <= 60) return 2.042 + (2.000 - 2.042) * (dof - 30) / 30.0;
+  if (dof <= 120) return 2.000 + (1.980 - 2.000) * (dof - 60) / 60.0;
+  return 1.96;
+}
+
+RunMetrics measureRun(const Scene& scene, Method method, const Progress& progress) {
+  std::unique_ptr<Simulation> sim = makeSimulation(scene, method);
+  const double h = scene.solver.time_step;
+  const Outputs& out = scene.outputs;
+  const Vec3 d = out.conveying_direction;
+  const long steps = std::lround(scene.duration / h);
+  const long every = std::max(1L, std::lround(out.sample_interval / h));
+  const long report_every = std::max(1L, steps / 100);
+
+  RunMetrics m;
+  m.scene = scene.name;
+  m.method = method;
+  m.time_step = h;
+  std::vector<Track> tracks;
+  int exited_total = 0, exited_after_warmup = 0;
+
+  auto crossed = [&](const Vec3& x) { return dot(x - out.exit_point, out.exit_normal) >= 0; };
+  // Drift coordinate progress of a part between two observations: along d, or the unwrapped
+  // angle about the axis.
+  const bool angular = out.angular_drift;
+  auto turn = [&](Track& tr, const Vec3& x) {
+    if (!angular) return;
+    const double a = angleAbout(x, out.axis_origin, out.axis_direction);
+    double da = a - tr.angle;
+    da -= 2 * kPi * std::round(da / (2 * kPi));
+    tr.turned += da;
+    tr.angle = a;
+  };
+  auto observe = [&](double t, bool sample) {
+    const int n = sim->numParts();
+    for (int i = static_cast<int>(tracks.size()); i < n; ++i) {
+      Track tr;
+      tr.spawn = tr.previous = sim->part(i).position;
+      tr.has_previous = true;
+      if (angular) tr.angle = angleAbout(tr.spawn, out.axis_origin, out.axis_direction);
+      tr.exited = out.exit_plane && crossed(tr.spawn);  // spawned beyond the exit: never counted
+      tracks.push_back(tr);
+    }
+    std::vector<double> v;
+    double z = 0;
+    int active = 0;
+    for (int i = 0; i < n; ++i) {
+      Track& tr = tracks[static_cast<std::size_t>(i)];
+      if (tr.exited) continue;
+      const PartState state = sim->part(i);
+      const Vec3 x = state.position;
+      turn(tr, x);
+      if (!state.active) {  // removed (fell out of the scene): its measurement ends here
+        tr.exited = true;
+        tr.end = x;
+        tr.end_turned = tr.turned;
+        tr.end_time = t;
+        continue;
+      }
+      if (tr.start_time < 0 && t >= out.warmup) {
+        tr.start = x;
+        tr.start_turned = tr.turned;
+        tr.start_time = t;
+      }
+      if (out.exit_plane && crossed(x)) {
+        tr.exited = true;
+        tr.end = x;
+        tr.end_turned = tr.turned;
+        tr.end_time = t;
+        ++exited_total;
+        if (t > out.warmup) ++exited_after_warmup;
+        continue;
+      }
+      if (sample) {
+        const double progress = angular ? tr.turned - tr.previous_turned : dot(x - tr.previous, d);
+        v.push_back(progress / (every * h));
+        tr.previous = x;
+        tr.previous_turned = tr.turned;
+        z += x.z;
+        ++active;
+      }
+    }
+    if (sample) {
+      DriftSample s;
+      s.time = t;
+      s.parts = active;
+      s.mean_velocity = mean(v);
+      s.ci95 = ci95(v);
+      s.mean_height = active ? z / active : 0;
+      s.exited = exited_total;
+      m.series.push_back(s);
+    }
+  };
+
+  const std::clock_t cpu_start = std::clock();
+  observe(0.0, false);
+  for (long k = 1; k <= steps; ++k) {
+    sim->step();
+    observe(sim->time(), k % every == 0);
+    if (progress && k % report_every == 0) progress(double(k) / steps);
+  }
+  m.cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  m.simulated_seconds = sim->time();
+  m.real_time_factor = m.simulated_seconds > 0 ? m.cpu_seconds / m.simulated_seconds : 0;
+  m.parts = sim->numParts();
+
+  std::vector<double> drift;
+  double dz = 0;
+  for (int i = 0; i < m.parts; ++i) {
+    Track& tr = tracks[static_cast<std::size_t>(i)];
+    const Vec3 x = sim->part(i).position;
+    if (!tr.exited || tr.end_time < 0) {
+      if (tr.exited) continue;  // spawned beyond the exit
+      tr.end = x;
+      tr.end_turned = tr.turned;
+      tr.end_time = m.simulated_seconds;
+    }
+    dz += tr.end.z - tr.spawn.z;
+    if (tr.start_time >= 0 && tr.end_time > tr.start_time) {
+      const double progress = angular ? tr.end_turned - tr.start_turned : dot(tr.end - tr.start, d);
+      drift.push_back(progress / (tr.end_time - tr.start_time));
+    }
+  }
+  m.mean_drift = mean(drift);
+  m.mean_drift_ci95 = ci95(drift);
+  m.vertical_displacement = m.parts ? dz / m.parts : 0;
+  const double window = m.simulated_seconds - out.warmup;
+  m.throughput = window > 0 ? exited_after_warmup / window : 0;
+  if (progress) progress(1.0);
+  return m;
+}
+
+Progress stderrProgress(const std::string& label) {
+  auto last = std::make_shared<std::chrono::steady_clock::time_point>();
+  return [label, last](double f) {
+    const auto now = std::chrono::steady_clock::now();
+    if (f < 1.0 && now - *last < std::chrono::milliseconds(500)) return;
+    *last = now;
+    std::fprintf(stderr, "\r%s: %3.0f %%%s", label.c_str(), 100 * f, f >= 1.0 ? "\n" : "");
+    std::fflush(stderr);
+  };
+}
+
+std::string seriesCsv(const RunMetrics& run) {
+  std::ostringstream s;
+  s << "time_s,parts,mean_velocity_mps,ci95_mps,mean_height_m,exited\n";
+  char line[160];
+  for (const DriftSample& d : run.series) {
+    std::snprintf(line, sizeof line, "%.6f,%d,%.8g,%.8g,%.8g,%d\n", d.time, d.parts,
+                  d.mean_velocity, d.ci95, d.mean_height, d.exited);
+    s << line;
+  }
+  return s.str();
+}
+
+std::string summaryJson(const RunMetrics& r) {
+  char b[768];
+  std::snprintf(b, sizeof b,
+                "{\"scene\": \"%s\", \"method\": \"%s\", \"time_step_s\": %.8g, \"parts\": %d, "
+                "\"mean_drift_mps\": %.8g, \"mean_drift_ci95_mps\": %.8g, "
+                "\"vertical_displacement_m\": %.8g, \"throughput_parts_per_s\": %.8g, "
+                "\"cpu_seconds\": %.6g, \"simulated_seconds\": %.6g, \"real_time_factor\": %.6g}",
+                r.scene.c_str(), toString(r.method), r.time_step, r.parts, r.mean_drift,
+                r.mean_drift_ci95, r.vertical_displacement, r.throughput, r.cpu_seconds,
+                r.simulated_seconds, r.real_time_factor);
+  return b;
+}
+
+std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::string& folder,
+                                         const std::string& stem) {
+  const std::filesystem::path base = std::filesystem::path(folder) / stem;
+  std::vector<std::string> written;
+  const std::string csv = seriesCsv(run);
+  writeFileAtomically(base.string() + ".csv", csv);
+  written.push_back(base.string() + ".csv");
+  writeFileAtomically(base.string() + ".json", summaryJson(run) + "\n");
+  written.push_back(base.string() + ".json");
+
+  std::ostringstream gp;
+  gp << "set datafile separator ','\n"
+     << "set key bottom right\nset grid\n"
+     << "set xlabel 'time (s)'\nset ylabel 'mean drift velocity (m/s)'\n"
+     << "set title '" << run.scene << ": " << toString(run.method) << ", h = " << run.time_step
+     << " s, " << run.parts << " parts'\n"
+     << "plot $data using 1:($3-$4):($3+$4) with filledcurves fc rgb '#c0d0f0' title '95 % CI', "
+        "$data using 1:3 with lines lw 2 lc rgb '#1040a0' title 'mean over parts'\n";
+  const std::string png = base.string() + ".png";
+  if (plotPng(gp.str(), {{"data", csv}}, png)) written.push_back(png);
+  return written;
+}
+
+}  // namespace rheofeed::scene

@@ -1,0 +1,936 @@
+// SPDX-License-Identifier: MIT
+// Scene files (JSON): text -> DOM (with paths, duplicate keys and overflowing numbers caught by
+// a SAX handler) -> Scene (every value type- and range-checked, unknown keys refused) ->
+// Scene::validate() -> meshes -> drawParts; and Scene -> JSON. The format is documented in
+// demos/scenes/README.md; the key names follow the field names of scene.hpp.
+#include "rheofeed/scene/scene_io.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "rheofeed/scene/mesh.hpp"
+
+namespace rheofeed::scene {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using ojson = nlohmann::ordered_json;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kFormatVersion = 1;
+// Distribution::max when a file gives none (scene.hpp's default: unbounded).
+constexpr double kUnbounded = Distribution{}.max;
+
+[[noreturn]] void fail(const std::string& path, const std::string& problem) {
+  throw SceneFileError("", path, problem);
+}
+
+std::string describe(const json& v) {
+  if (v.is_object()) return "an object";
+  if (v.is_array()) return "an array of " + std::to_string(v.size());
+  std::string s = v.dump();
+  return s.size() > 40 ? s.substr(0, 37) + "..." : s;
+}
+
+std::string show(double v) {
+  std::ostringstream out;
+  out.precision(10);
+  out << v;
+  return out.str();
+}
+
+// ---- Text to DOM -------------------------------------------------------------------------------
+
+// Builds the DOM like nlohmann's own parser, and besides knows the JSON path of the value being
+// read, so that a duplicate key or a number that overflows a double (1e999) is reported with it.
+class DomBuilder final : public nlohmann::json_sax<json> {
+ public:
+  explicit DomBuilder(json& root) : root_(root) {}
+
+  bool null() override { return value(nullptr); }
+  bool boolean(bool v) override { return value(v); }
+  bool number_integer(number_integer_t v) override { return value(v); }
+  bool number_unsigned(number_unsigned_t v) override { return value(v); }
+  bool number_float(number_float_t v, const string_t&) override { return value(v); }
+  bool string(string_t& v) override { return value(v); }
+  bool binary(binary_t&) override { return value(nullptr); }  // never in JSON text
+  bool start_object(std::size_t) override { return open(json::object()); }
+  bool end_object() override { return close(); }
+  bool start_array(std::size_t) override { return open(json::array()); }
+  bool end_array() override { return close(); }
+  bool key(string_t& k) override {
+    Frame& f = frames_.back();
+    if (!f.keys.insert(k).second) {
+      path_ = join(pathOf(frames_.size() - 1), k);
+      problem_ = "duplicate key (each key may appear once per object)";
+      return false;
+    }
+    f.key = k;
+    slot_ = &(*containers_.back())[k];
+    return true;
+  }
+  bool parse_error(std::size_t byte, const std::string& token,
+                   const nlohmann::json::exception& e) override {
+    byte_ = byte;
+    if (e.id == 406) {  // out_of_range.406: number overflow
+      path_ = pathOf(frames_.size());
+      problem_ = "the number " + token + " is not finite (it overflows a double)";
+    } else {  // drop nlohmann's "[json.exception...] parse error at line L, column C: "
+      std::string what = e.what();
+      const std::size_t column = what.find("column ");
+      const std::size_t colon = what.find(": ", column == std::string::npos ? 0 : column);
+      if (colon != std::string::npos) what.erase(0, colon + 2);
+      problem_ = what.rfind("syntax error", 0) == 0 ? "JSON " + what : "JSON syntax error: " + what;
+    }
+    return false;
+  }
+
+  const std::string& path() const { return path_; }
+  const std::string& problem() const { return problem_; }
+  std::size_t byte() const { return byte_; }
+
+ private:
+  struct Frame {
+    bool array = false;
+    std::size_t index = 0;  // array: index of the element being read
+    std::string key;        // object: key of the element being read
+    std::set<std::string> keys;
+  };
+
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+  // The path of the element being read at depth n (n frames).
+  std::string pathOf(std::size_t n) const {
+    std::string p;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Frame& f = frames_[i];
+      if (f.array) {
+        p += "[" + std::to_string(f.index) + "]";
+      } else if (!f.key.empty()) {
+        p = join(p, f.key);
+      }
+    }
+    return p;
+  }
+  json* place(json v) {
+    if (containers_.empty()) {
+      root_ = std::move(v);
+      return &root_;
+    }
+    json& top = *containers_.back();
+    if (top.is_array()) {
+      top.push_back(std::move(v));
+      return &top.back();
+    }
+    *slot_ = std::move(v);
+    return slot_;
+  }
+  void elementDone() {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+  }
+  bool value(json v) {
+    place(std::move(v));
+    elementDone();
+    return true;
+  }
+  bool open(json v) {
+    const bool array = v.is_array();
+    containers_.push_back(place(std::move(v)));
+    frames_.push_back(Frame{array, 0, {}, {}});
+    return true;
+  }
+  bool close() {
+    containers_.pop_back();
+    frames_.pop_back();
+    elementDone();
+    return true;
+  }
+
+  json& root_;
+  std::vector<json*> containers_;  // open objects and arrays, innermost last
+  std::vector<Frame> frames_;
+  json* slot_ = nullptr;  // the value slot of the last key read
+  std::string path_, problem_;
+  std::size_t byte_ = 0;
+};
+
+json parseText(const std::string& text) {
+  json root;
+  DomBuilder builder(root);
+  if (json::sax_parse(text, &builder)) return root;
+  int line = 0, column = 0;
+  if (builder.byte() > 0) {  // byte: characters read when the error was found
+    const std::size_t end = std::min(builder.byte(), text.size());
+    line = 1;
+    std::size_t line_start = 0;
+    for (std::size_t i = 0; i + 1 < end; ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        line_start = i + 1;
+      }
+    }
+    column = std::max(1, static_cast<int>(end - line_start));
+  }
+  throw SceneFileError("", builder.path(), builder.problem(), line, column);
+}
+
+// ---- DOM to values -----------------------------------------------------------------------------
+
+enum class Range { Any, Positive, NonNegative, UnitInterval };
+struct UnitVector {};  // tag: read a direction, refuse zero, normalise
+
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// The closest of `options` to `word` if it is close enough to be a typo of it, else "".
+std::string closest(const std::string& word, const std::vector<std::string>& options) {
+  std::string best;
+  std::size_t best_distance = std::max<std::size_t>(2, word.size() / 3) + 1;
+  for (const std::string& o : options) {
+    const std::size_t d = editDistance(word, o);
+    if (d < best_distance) {
+      best = o;
+      best_distance = d;
+    }
+  }
+  return best;
+}
+
+void checkRange(const std::string& path, double v, Range range) {
+  if (!std::isfinite(v)) fail(path, "must be finite, got " + show(v));
+  switch (range) {
+    case Range::Any:
+      break;
+    case Range::Positive:
+      if (!(v > 0)) fail(path, "must be > 0, got " + show(v));
+      break;
+    case Range::NonNegative:
+      if (!(v >= 0)) fail(path, "must be >= 0, got " + show(v));
+      break;
+    case Range::UnitInterval:
+      if (!(v >= 0 && v <= 1)) fail(path, "must be in [0, 1], got " + show(v));
+      break;
+  }
+}
+
+void read(const json& v, const std::string& path, double& out, Range range = Range::Any) {
+  if (!v.is_number()) fail(path, "expected a number, got " + describe(v));
+  out = v.get<double>();
+  checkRange(path, out, range);
+}
+
+void read(const json& v, const std::string& path, int& out, int min) {
+  double d = 0;
+  read(v, path, d);
+  if (d != std::floor(d) || std::abs(d) > 2e9)
+    fail(path, "expected an integer, got " + describe(v));
+  if (d < min) fail(path, "must be >= " + std::to_string(min) + ", got " + describe(v));
+  out = static_cast<int>(d);
+}
+
+void read(const json& v, const std::string& path, std::uint64_t& out) {
+  if (v.is_number_unsigned()) {
+    out = v.get<std::uint64_t>();
+    return;
+  }
+  double d = 0;
+  read(v, path, d);
+  if (d != std::floor(d) || d < 0 || d >= 18446744073709551616.0) {
+    fail(path, "expected an integer >= 0, got " + describe(v));
+  }
+  out = static_cast<std::uint64_t>(d);
+}
+
+void read(const json& v, const std::string& path, bool& out) {
+  if (!v.is_boolean()) fail(path, "expected true or false, got " + describe(v));
+  out = v.get<bool>();
+}
+
+void read(const json& v, const std::string& path, std::string& out) {
+  if (!v.is_string()) fail(path, "expected a string, got " + describe(v));
+  out = v.get<std::string>();
+}
+
+void read(const json& v, const std::string& path, Vec3& out, Range range = Range::Any) {
+  if (!v.is_array() || v.size() != 3) fail(path, "expected [x, y, z], got " + describe(v));
+  read(v[0], path + "[0]", out.x, range);
+  read(v[1], path + "[1]", out.y, range);
+  read(v[2], path + "[2]", out.z, range);
+}
+
+void read(const json& v, const std::string& path, Vec3& out, UnitVector) {
+  read(v, path, out);
+  const double n = norm(out);
+  if (!(n > 0) || !std::isfinite(n)) fail(path, "a direction must not be the zero vector");
+  out = (1.0 / n) * out;
+}
+
+// Readers of composite values (defined below; declared here for Object's templates).
+void read(const json& v, const std::string& path, Distribution& out);
+void read(const json& v, const std::string& path, Twist& out);
+void read(const json& v, const std::string& path, Pose& out);
+void read(const json& v, const std::string& path, FeederLaw& law);
+
+// A JSON object being read: every key asked for is remembered, and finish() refuses the rest.
+class Object {
+ public:
+  Object(const json& j, std::string path) : j_(j), path_(std::move(path)) {
+    if (!j.is_object()) fail(path_, "expected an object, got " + describe(j));
+    std::string comment;  // "comment" is allowed everywhere and ignored
+    opt("comment", comment);
+  }
+
+  std::string at(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  bool has(const char* key) const { return j_.contains(key); }
+
+  const json* find(const char* key) {
+    known_.emplace_back(key);
+    const auto it = j_.find(key);
+    return it == j_.end() ? nullptr : &*it;
+  }
+  const json& require(const char* key) {
+    if (const json* v = find(key)) return *v;
+    std::vector<std::string> unknown;
+    for (const auto& item : j_.items()) {
+      if (std::find(known_.begin(), known_.end(), item.key()) == known_.end()) {
+        unknown.push_back(item.key());
+      }
+    }
+    const std::string typo = closest(key, unknown);
+    fail(at(key), "missing required key" + (typo.empty() ? "" : " (is \"" + typo + "\" a typo?)"));
+  }
+  template <class T, class... Extra>
+  bool opt(const char* key, T& out, Extra... extra) {
+    const json* v = find(key);
+    if (v) read(*v, at(key), out, extra...);
+    return v != nullptr;
+  }
+  template <class T, class... Extra>
+  void req(const char* key, T& out, Extra... extra) {
+    read(require(key), at(key), out, extra...);
+  }
+  // An angle given as "<stem>_deg" or "<stem>_rad" (not both); out in radians.
+  bool optAngle(const std::string& stem, double& out_rad, Range range = Range::Any) {
+    const std::string deg = stem + "_deg", rad = stem + "_rad";
+    const json* d = find(deg.c_str());
+    const json* r = find(rad.c_str());
+    if (d && r) fail(at(deg), "give either " + deg + " or " + rad + ", not both");
+    if (d) {
+      read(*d, at(deg), out_rad, range);
+      out_rad *= kPi / 180;
+    } else if (r) {
+      read(*r, at(rad), out_rad, range);
+    }
+    return d || r;
+  }
+  void reqAngle(const std::string& stem, double& out_rad, Range range = Range::Any) {
+    if (!optAngle(stem, out_rad, range)) fail(at(stem + "_deg"), "missing (or " + stem + "_rad)");
+  }
+  // Refuses every key that was not asked for.
+  void finish() const {
+    for (const auto& item : j_.items()) {
+      if (std::find(known_.begin(), known_.end(), item.key()) != known_.end()) continue;
+      std::string list;
+      std::set<std::string> listed{"comment"};
+      for (const std::string& k : known_) {
+        if (listed.insert(k).second) list += (list.empty() ? "" : ", ") + k;
+      }
+      const std::string typo = closest(item.key(), known_);
+      fail(at(item.key()), "unknown key" +
+                               (typo.empty() ? "" : " (did you mean \"" + typo + "\"?)") +
+                               "; expected one of: " + list);
+    }
+  }
+
+ private:
+  const json& j_;
+  std::string path_;
+  std::vector<std::string> known_;
+};
+
+void read(const json& v, const std::string& path, Distribution& out) {
+  if (v.is_number()) {
+    out = Distribution{};
+    read(v, path, out.mean, Range::Positive);
+    return;
+  }
+  if (!v.is_object()) {
+    fail(path, "expected a number or {\"mean\": ..., \"stddev\": ...}, got " + describe(v));
+  }
+  Object o(v, path);
+  o.req("mean", out.mean, Range::Positive);
+  o.opt("stddev", out.stddev, Range::NonNegative);
+  o.opt("min", out.min, Range::NonNegative);
+  o.opt("max", out.max, Range::Positive);
+  o.finish();
+}
+
+void read(const json& v, const std::string& path, Twist& out) {
+  Object o(v, path);
+  o.opt("linear", out.linear);
+  o.opt("angular", out.angular);
+  o.opt("origin", out.origin);
+  o.finish();
+}
+
+void read(const json& v, const std::string& path, Pose& out) {  // rotation part only
+  Object o(v, path);
+  Vec3 axis;
+  double angle = 0;
+  o.req("axis", axis, UnitVector{});
+  o.reqAngle("angle", angle);
+  o.finish();
+  const Eigen::Matrix3d r =
+      Eigen::AngleAxisd(angle, Eigen::Vector3d(axis.x, axis.y, axis.z)).matrix();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) out.rotation[3 * i + j] = r(i, j);
+  }
+}
+
+Shape::Kind shapeKind(const json& v, const std::string& path) {
+  std::string name;
+  read(v, path, name);
+  for (Shape::Kind k : {Shape::Kind::Box, Shape::Kind::Sphere, Shape::Kind::Cylinder,
+                        Shape::Kind::Capsule, Shape::Kind::Plane, Shape::Kind::Mesh}) {
+    if (name == toString(k)) return k;
+  }
+  fail(path,
+       "unknown shape \"" + name + "\"; expected box, sphere, cylinder, capsule, plane or mesh");
+}
+
+void readVibration(Object& o, Vibration& v) {
+  o.opt("amplitude", v.amplitude, Range::NonNegative);
+  o.req("frequency", v.frequency, Range::Positive);
+  double angle = 0;
+  if (o.optAngle("angle", angle)) {  // throw angle above +x, in the x-z plane
+    if (o.has("direction")) fail(o.at("direction"), "give either direction or angle, not both");
+    v.direction = {std::cos(angle), 0, std::sin(angle)};
+  } else {
+    o.opt("direction", v.direction, UnitVector{});
+  }
+  o.optAngle("phase", v.phase);
+  o.optAngle("torsion_amplitude", v.torsion_amplitude, Range::NonNegative);
+  o.opt("axis_origin", v.axis_origin);
+  o.opt("axis_direction", v.axis_direction, UnitVector{});
+}
+
+// A bowl's screw motion: translation along the torsion axis in phase with the torsion.
+void readScrew(Object& o, Vibration& v) {
+  o.opt("vertical_amplitude", v.amplitude, Range::NonNegative);
+  o.optAngle("torsion_amplitude", v.torsion_amplitude, Range::NonNegative);
+  o.req("frequency", v.frequency, Range::Positive);
+  o.optAngle("phase", v.phase);
+  o.opt("axis_origin", v.axis_origin);
+  o.opt("axis_direction", v.axis_direction, UnitVector{});
+  v.direction = v.axis_direction;
+  if (v.isZero()) {
+    fail(o.at("vertical_amplitude"),
+         "a screw motion needs vertical_amplitude or "
+         "torsion_amplitude_deg/_rad > 0");
+  }
+}
+
+void read(const json& v, const std::string& path, FeederLaw& law) {
+  if (v.is_string() && v.get<std::string>() == "none") return;
+  Object o(v, path);
+  const char* kinds[] = {"drift", "belt", "vibration", "screw"};
+  const char* given = nullptr;
+  for (const char* k : kinds) {
+    if (!o.has(k)) continue;
+    if (given) fail(o.at(k), std::string("a law has one kind; \"") + given + "\" is given too");
+    given = k;
+  }
+  if (!given) {
+    fail(path,
+         "expected one of \"drift\", \"belt\", \"vibration\", \"screw\" (or no \"law\" "
+         "for a fixture that does not move)");
+  }
+  const std::string kind = given;
+  if (o.has("calibrated_drift") && (kind == "drift" || kind == "belt")) {
+    fail(o.at("calibrated_drift"), "only a vibration or screw law has a calibrated drift");
+  }
+  if (kind == "drift") {
+    law.kind = FeederLaw::Kind::Drift;
+    o.req("drift", law.drift);
+  } else if (kind == "belt") {
+    law.kind = FeederLaw::Kind::Belt;
+    Object belt(*o.find("belt"), o.at(kind));
+    belt.req("direction", law.belt_direction, UnitVector{});
+    belt.req("speed", law.belt_speed);
+    belt.finish();
+  } else {
+    law.kind = FeederLaw::Kind::Vibration;
+    Object body(*o.find(given), o.at(kind));
+    kind == "vibration" ? readVibration(body, law.vibration) : readScrew(body, law.vibration);
+    body.finish();
+    if (o.opt("calibrated_drift", law.calibrated_drift)) law.has_calibrated_drift = true;
+  }
+  o.finish();
+}
+
+Fixture::Geom readGeom(const json& v, const std::string& path) {
+  Object o(v, path);
+  Fixture::Geom g;
+  Shape& s = g.shape;
+  s.kind = shapeKind(o.require("shape"), o.at("shape"));
+  switch (s.kind) {
+    case Shape::Kind::Box:
+      o.req("size", s.size, Range::Positive);
+      break;
+    case Shape::Kind::Sphere:
+      o.req("radius", s.radius, Range::Positive);
+      break;
+    case Shape::Kind::Cylinder:
+    case Shape::Kind::Capsule:
+      o.req("radius", s.radius, Range::Positive);
+      o.req("length", s.length, Range::Positive);
+      break;
+    case Shape::Kind::Plane:
+      o.req("normal", s.plane_normal, UnitVector{});
+      o.opt("offset", s.plane_offset);
+      break;
+    case Shape::Kind::Mesh:
+      o.req("mesh", s.mesh);
+      if (s.mesh.empty()) fail(o.at("mesh"), "empty file name");
+      o.opt("scale", s.mesh_scale, Range::Positive);
+      break;
+  }
+  if (s.kind != Shape::Kind::Plane) {  // a plane is placed by its equation
+    o.opt("position", g.pose.position);
+    o.opt("rotation", g.pose);
+  }
+  o.finish();
+  return g;
+}
+
+template <class T, class F>
+std::vector<T> readArray(const json& v, const std::string& path, F element) {
+  if (!v.is_array()) fail(path, "expected an array, got " + describe(v));
+  std::vector<T> out;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    out.push_back(element(v[i], path + "[" + std::to_string(i) + "]"));
+  }
+  return out;
+}
+
+Fixture readFixture(const json& v, const std::string& path) {
+  Object o(v, path);
+  Fixture f;
+  o.opt("name", f.name);
+  f.geoms = readArray<Fixture::Geom>(o.require("geoms"), o.at("geoms"), readGeom);
+  o.opt("law", f.law);
+  o.finish();
+  return f;
+}
+
+int sizeCount(Shape::Kind kind) {
+  switch (kind) {
+    case Shape::Kind::Box:
+      return 3;
+    case Shape::Kind::Cylinder:
+    case Shape::Kind::Capsule:
+      return 2;
+    default:
+      return 1;
+  }
+}
+
+PartSpec readPart(const json& v, const std::string& path) {
+  Object o(v, path);
+  PartSpec p;
+  o.opt("name", p.name);
+  p.shape = shapeKind(o.require("shape"), o.at("shape"));
+  if (p.shape == Shape::Kind::Plane) fail(o.at("shape"), "a part cannot be a plane");
+  const int n = sizeCount(p.shape);
+  if (p.shape == Shape::Kind::Mesh) {
+    o.req("mesh", p.mesh);
+    if (p.mesh.empty()) fail(o.at("mesh"), "empty file name");
+    p.size[0] = Distribution{};
+    p.size[0].mean = 1.0;  // the scale factor
+  }
+  const json* size = p.shape == Shape::Kind::Mesh ? o.find("size") : &o.require("size");
+  if (size) {
+    static const char* kMeaning[] = {"", "sphere: radius; mesh: scale", "radius, length",
+                                     "x, y, z edges"};
+    if (!size->is_array() || static_cast<int>(size->size()) != n) {
+      fail(o.at("size"), std::string("a ") + toString(p.shape) + " part needs an array of " +
+                             std::to_string(n) + " sizes (" + kMeaning[n] + "), got " +
+                             describe(*size));
+    }
+    for (int d = 0; d < n; ++d)
+      read((*size)[d], o.at("size") + "[" + std::to_string(d) + "]", p.size[d]);
+  }
+  o.opt("density", p.density, Range::Positive);
+  o.req("spawn_min", p.spawn_min);
+  o.req("spawn_max", p.spawn_max);
+  o.opt("random_orientation", p.random_orientation);
+  o.opt("count", p.count, 1);
+  o.opt("rate", p.rate, Range::NonNegative);
+  o.opt("initial_velocity", p.initial_velocity);
+  o.finish();
+  return p;
+}
+
+Scene readScene(const json& root) {
+  Object o(root, "");
+  Scene s;
+  int version = kFormatVersion;
+  if (o.opt("format_version", version, 1) && version != kFormatVersion) {
+    fail("format_version", "this build reads version " + std::to_string(kFormatVersion) +
+                               ", the file is version " + std::to_string(version));
+  }
+  o.opt("name", s.name);
+  o.opt("gravity", s.gravity);
+  if (const json* v = o.find("fixtures"))
+    s.fixtures = readArray<Fixture>(*v, "fixtures", readFixture);
+  s.parts = readArray<PartSpec>(o.require("parts"), "parts", readPart);
+  if (const json* v = o.find("material")) {
+    Object m(*v, "material");
+    m.opt("mu", s.material.mu, Range::NonNegative);
+    m.opt("restitution", s.material.restitution, Range::UnitInterval);
+    m.finish();
+  }
+  if (const json* v = o.find("solver")) {
+    Object m(*v, "solver");
+    SolverSettings& x = s.solver;
+    m.opt("time_step", x.time_step, Range::Positive);
+    m.opt("iterations", x.iterations, 1);
+    m.opt("ode_quickstep", x.ode_quickstep);
+    m.opt("erp", x.erp, Range::UnitInterval);
+    m.opt("cfm", x.cfm, Range::NonNegative);
+    m.opt("tolerance", x.tolerance, Range::Positive);
+    m.opt("apgd", x.apgd);
+    m.opt("coulomb_iterations", x.coulomb_iterations, 0);
+    m.opt("max_correcting_velocity", x.max_correcting_velocity, Range::Positive);
+    m.finish();
+  }
+  o.opt("duration", s.duration, Range::Positive);
+  o.opt("removal_height", s.removal_height);
+  o.opt("seed", s.seed);
+  if (const json* v = o.find("outputs")) {
+    Object m(*v, "outputs");
+    Outputs& x = s.outputs;
+    m.opt("conveying_direction", x.conveying_direction, UnitVector{});
+    m.opt("angular_drift", x.angular_drift);
+    m.opt("axis_origin", x.axis_origin);
+    m.opt("axis_direction", x.axis_direction, UnitVector{});
+    m.opt("exit_plane", x.exit_plane);
+    m.opt("exit_point", x.exit_point);
+    m.opt("exit_normal", x.exit_normal, UnitVector{});
+    m.opt("sample_interval", x.sample_interval, Range::Positive);
+    m.opt("warmup", x.warmup, Range::NonNegative);
+    m.finish();
+  }
+  o.finish();
+  return s;
+}
+
+// Scene::validate() and drawParts() say "<path> = <value>: <why>" or "<path>: <why>" or
+// "<path> <more>: <why>"; split off the path so that the error names it like the parser does.
+[[noreturn]] void rethrowWithPath(const std::exception& e) {
+  const std::string msg = e.what();
+  const std::size_t end = msg.find_first_of(" :");
+  if (end == std::string::npos) fail("", msg);
+  const std::string path = msg.substr(0, end);
+  std::string rest = msg.substr(end);
+  if (rest.compare(0, 3, " = ") == 0) {
+    const std::size_t colon = rest.find(": ");
+    if (colon != std::string::npos) {
+      fail(path, rest.substr(colon + 2) + " (got " + rest.substr(3, colon - 3) + ")");
+    }
+  }
+  rest.erase(0, rest.find_first_not_of(" :"));
+  fail(path, rest);
+}
+
+// ---- Scene to JSON -----------------------------------------------------------------------------
+
+// Like dump(2), but arrays of numbers, strings and booleans stay on one line: [0.0, 0.0, 1.0].
+void pretty(const ojson& v, int indent, std::string& out) {
+  const bool flat = v.is_array() && std::none_of(v.begin(), v.end(),
+                                                 [](const ojson& e) { return e.is_structured(); });
+  if (!v.is_structured() || v.empty()) {
+    out += v.dump();
+  } else if (flat) {
+    out += "[";
+    for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + v[i].dump();
+    out += "]";
+  } else {
+    const std::string pad(indent + 2, ' ');
+    out += v.is_object() ? "{\n" : "[\n";
+    for (auto it = v.begin(); it != v.end(); ++it) {
+      out += (it == v.begin() ? "" : ",\n") + pad;
+      if (v.is_object()) out += ojson(it.key()).dump() + ": ";
+      pretty(*it, indent + 2, out);
+    }
+    out += "\n" + std::string(indent, ' ') + (v.is_object() ? "}" : "]");
+  }
+}
+
+ojson toJson(const Vec3& v) {
+  return ojson::array({v.x, v.y, v.z});
+}
+
+ojson toJson(const Twist& t) {
+  return ojson{
+      {"linear", toJson(t.linear)}, {"angular", toJson(t.angular)}, {"origin", toJson(t.origin)}};
+}
+
+ojson toJson(const Distribution& d) {
+  if (d.stddev == 0 && d.min == 0 && d.max == kUnbounded) return d.mean;
+  ojson out{{"mean", d.mean}, {"stddev", d.stddev}, {"min", d.min}};
+  if (d.max != kUnbounded) out["max"] = d.max;
+  return out;
+}
+
+bool isIdentity(const Pose& p) {
+  const Pose identity;
+  return std::equal(p.rotation, p.rotation + 9, identity.rotation);
+}
+
+ojson rotationJson(const Pose& p) {
+  Eigen::Matrix3d r;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) r(i, j) = p.rotation[3 * i + j];
+  }
+  const Eigen::AngleAxisd aa(r);
+  const Eigen::Vector3d& a = aa.axis();
+  return ojson{{"axis", toJson(Vec3{a.x(), a.y(), a.z()})}, {"angle_rad", aa.angle()}};
+}
+
+ojson toJson(const Fixture::Geom& g) {
+  const Shape& s = g.shape;
+  ojson out{{"shape", toString(s.kind)}};
+  switch (s.kind) {
+    case Shape::Kind::Box:
+      out["size"] = toJson(s.size);
+      break;
+    case Shape::Kind::Sphere:
+      out["radius"] = s.radius;
+      break;
+    case Shape::Kind::Cylinder:
+    case Shape::Kind::Capsule:
+      out["radius"] = s.radius;
+      out["length"] = s.length;
+      break;
+    case Shape::Kind::Plane:
+      out["normal"] = toJson(s.plane_normal);
+      out["offset"] = s.plane_offset;
+      return out;
+    case Shape::Kind::Mesh:
+      out["mesh"] = s.mesh;
+      out["scale"] = s.mesh_scale;
+      break;
+  }
+  out["position"] = toJson(g.pose.position);
+  if (!isIdentity(g.pose)) out["rotation"] = rotationJson(g.pose);
+  return out;
+}
+
+ojson toJson(const FeederLaw& law) {
+  switch (law.kind) {
+    case FeederLaw::Kind::None:
+      return "none";
+    case FeederLaw::Kind::Drift:
+      return ojson{{"drift", toJson(law.drift)}};
+    case FeederLaw::Kind::Belt:
+      return ojson{
+          {"belt", ojson{{"direction", toJson(law.belt_direction)}, {"speed", law.belt_speed}}}};
+    case FeederLaw::Kind::Vibration: {
+      const Vibration& v = law.vibration;
+      ojson out{{"vibration", ojson{{"amplitude", v.amplitude},
+                                    {"frequency", v.frequency},
+                                    {"direction", toJson(v.direction)},
+                                    {"phase_rad", v.phase},
+                                    {"torsion_amplitude_rad", v.torsion_amplitude},
+                                    {"axis_origin", toJson(v.axis_origin)},
+                                    {"axis_direction", toJson(v.axis_direction)}}}};
+      if (law.has_calibrated_drift) out["calibrated_drift"] = toJson(law.calibrated_drift);
+      return out;
+    }
+  }
+  return "none";
+}
+
+ojson toJson(const PartSpec& p) {
+  ojson out{{"name", p.name}, {"shape", toString(p.shape)}};
+  if (p.shape == Shape::Kind::Mesh) out["mesh"] = p.mesh;
+  ojson size = ojson::array();
+  for (int d = 0; d < sizeCount(p.shape); ++d) size.push_back(toJson(p.size[d]));
+  out["size"] = size;
+  out["density"] = p.density;
+  out["spawn_min"] = toJson(p.spawn_min);
+  out["spawn_max"] = toJson(p.spawn_max);
+  out["random_orientation"] = p.random_orientation;
+  out["count"] = p.count;
+  out["rate"] = p.rate;
+  out["initial_velocity"] = toJson(p.initial_velocity);
+  return out;
+}
+
+}  // namespace
+
+SceneFileError::SceneFileError(std::string source, std::string path, std::string problem, int line,
+                               int column)
+    : std::invalid_argument([&] {
+        std::string s = source;
+        if (line > 0) s += ":" + std::to_string(line) + ":" + std::to_string(column);
+        if (!path.empty()) s += (s.empty() ? "" : ": ") + path;
+        return s + (s.empty() ? "" : ": ") + problem;
+      }()),
+      source_(std::move(source)),
+      path_(std::move(path)),
+      problem_(std::move(problem)),
+      line_(line),
+      column_(column) {}
+
+void loadSceneMeshes(Scene& scene, const fs::path& base_dir, const MeshLoader& mesh_loader) {
+  const MeshLoader load = mesh_loader ? mesh_loader : MeshLoader(loadTriangleMesh);
+  std::map<std::pair<std::string, double>, std::shared_ptr<const TriangleMesh>> cache;
+  auto get = [&](std::string& file, double scale, const std::string& path) {
+    fs::path p(file);
+    if (p.is_relative()) p = base_dir / p;
+    file = fs::absolute(p).lexically_normal().string();
+    std::shared_ptr<const TriangleMesh>& mesh = cache[{file, scale}];
+    if (!mesh) {
+      try {
+        TriangleMesh m = load(file, scale);
+        if (m.source.empty()) m.source = file;
+        mesh = std::make_shared<const TriangleMesh>(std::move(m));
+      } catch (const std::exception& e) {
+        fail(path, e.what());
+      }
+    }
+    return mesh;
+  };
+  for (std::size_t i = 0; i < scene.fixtures.size(); ++i) {
+    for (std::size_t g = 0; g < scene.fixtures[i].geoms.size(); ++g) {
+      Shape& s = scene.fixtures[i].geoms[g].shape;
+      if (s.kind != Shape::Kind::Mesh) continue;
+      const std::string path =
+          "fixtures[" + std::to_string(i) + "].geoms[" + std::to_string(g) + "].mesh";
+      s.mesh_data = get(s.mesh, s.mesh_scale, path);
+    }
+  }
+  for (std::size_t i = 0; i < scene.parts.size(); ++i) {
+    PartSpec& p = scene.parts[i];
+    if (p.shape != Shape::Kind::Mesh) continue;
+    const std::string path = "parts[" + std::to_string(i) + "].mesh";
+    const std::shared_ptr<const TriangleMesh> mesh = get(p.mesh, 1.0, path);
+    try {  // a part must be a closed, outward-oriented solid; centre it on its centre of mass
+      const MassProperties mp = massProperties(*mesh, 1.0);
+      p.mesh_data = std::make_shared<const TriangleMesh>(translateMesh(*mesh, -mp.centre_of_mass));
+    } catch (const std::exception& e) {
+      fail(path, e.what());
+    }
+  }
+}
+
+Scene parseScene(const std::string& json_text, const std::string& source_name,
+                 const MeshLoader& mesh_loader) {
+  try {
+    Scene scene = readScene(parseText(json_text));
+    try {
+      scene.validate();
+    } catch (const std::invalid_argument& e) {
+      rethrowWithPath(e);
+    }
+    if (scene.hasMeshes()) loadSceneMeshes(scene, fs::path(source_name).parent_path(), mesh_loader);
+    try {
+      (void)drawParts(scene);  // refuses spawn regions too small for the parts
+    } catch (const std::invalid_argument& e) {
+      rethrowWithPath(e);
+    }
+    return scene;
+  } catch (const SceneFileError& e) {
+    throw SceneFileError(source_name, e.path(), e.problem(), e.line(), e.column());
+  }
+}
+
+Scene loadScene(const fs::path& file, const MeshLoader& mesh_loader) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw SceneFileError(file.string(), "", "cannot open the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw SceneFileError(file.string(), "", "cannot read the file");
+  return parseScene(text.str(), file.string(), mesh_loader);
+}
+
+std::string toJson(const Scene& scene) {
+  ojson out;
+  out["format_version"] = kFormatVersion;
+  out["name"] = scene.name;
+  out["gravity"] = toJson(scene.gravity);
+  out["duration"] = scene.duration;
+  out["removal_height"] = scene.removal_height;
+  out["seed"] = scene.seed;
+  ojson fixtures = ojson::array();
+  for (const Fixture& f : scene.fixtures) {
+    ojson fj{{"name", f.name}};
+    ojson geoms = ojson::array();
+    for (const Fixture::Geom& g : f.geoms) geoms.push_back(toJson(g));
+    fj["geoms"] = geoms;
+    if (f.law.kind != FeederLaw::Kind::None) fj["law"] = toJson(f.law);
+    fixtures.push_back(fj);
+  }
+  out["fixtures"] = fixtures;
+  ojson parts = ojson::array();
+  for (const PartSpec& p : scene.parts) parts.push_back(toJson(p));
+  out["parts"] = parts;
+  out["material"] = {{"mu", scene.material.mu}, {"restitution", scene.material.restitution}};
+  const SolverSettings& x = scene.solver;
+  out["solver"] = {{"time_step", x.time_step},
+                   {"iterations", x.iterations},
+                   {"ode_quickstep", x.ode_quickstep},
+                   {"erp", x.erp},
+                   {"cfm", x.cfm},
+                   {"tolerance", x.tolerance},
+                   {"apgd", x.apgd},
+                   {"coulomb_iterations", x.coulomb_iterations},
+                   {"max_correcting_velocity", x.max_correcting_velocity}};
+  const Outputs& o = scene.outputs;
+  const Outputs defaults;
+  ojson oj{{"conveying_direction", toJson(o.conveying_direction)}};
+  oj["angular_drift"] = o.angular_drift;
+  if (o.angular_drift || o.axis_origin != defaults.axis_origin ||
+      o.axis_direction != defaults.axis_direction) {
+    oj["axis_origin"] = toJson(o.axis_origin);
+    oj["axis_direction"] = toJson(o.axis_direction);
+  }
+  oj["exit_plane"] = o.exit_plane;
+  if (o.exit_plane || o.exit_point != defaults.exit_point ||
+      o.exit_normal != defaults.exit_normal) {
+    oj["exit_point"] = toJson(o.exit_point);
+    oj["exit_normal"] = toJson(o.exit_normal);
+  }
+  oj["sample_interval"] = o.sample_interval;
+  oj["warmup"] = o.warmup;
+  out["outputs"] = oj;
+  std::string text;
+  pretty(out, 0, text);
+  return text + "\n";
+}
+
+}  // namespace rheofeed::scene

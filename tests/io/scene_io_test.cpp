@@ -1,0 +1,597 @@
+// SPDX-License-Identifier: MIT
+// Scene files: a full round trip, and every kind of bad input refused with the JSON path of the
+// bad value and the file name.
+#include "rheofeed/scene/scene_io.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "rheofeed/scene/mesh.hpp"
+
+namespace rheofeed::scene {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kData = RHEOFEED_IO_TEST_DATA;
+constexpr double kPi = 3.14159265358979323846;
+// Rotations go through axis-angle in the file: a few ulp per matrix entry.
+constexpr double kRotationTolerance = 1e-14;
+
+// A stand-in mesh loader: the test box (closed), with a call counter.
+struct CountingLoader {
+  int calls = 0;
+  MeshLoader loader() {
+    return [this](const fs::path& file, double scale) {
+      ++calls;
+      TriangleMesh m = loadTriangleMesh(kData / "box_20x30x40mm.obj", scale);
+      m.source = file.string();
+      return m;
+    };
+  }
+};
+
+void expectSame(const Vec3& a, const Vec3& b, const std::string& what) {
+  EXPECT_EQ(a.x, b.x) << what;
+  EXPECT_EQ(a.y, b.y) << what;
+  EXPECT_EQ(a.z, b.z) << what;
+}
+void expectSame(const Twist& a, const Twist& b, const std::string& what) {
+  expectSame(a.linear, b.linear, what + ".linear");
+  expectSame(a.angular, b.angular, what + ".angular");
+  expectSame(a.origin, b.origin, what + ".origin");
+}
+void expectSame(const Distribution& a, const Distribution& b, const std::string& what) {
+  EXPECT_EQ(a.mean, b.mean) << what;
+  EXPECT_EQ(a.stddev, b.stddev) << what;
+  EXPECT_EQ(a.min, b.min) << what;
+  EXPECT_EQ(a.max, b.max) << what;
+}
+
+// Every field of scene.hpp that a file carries.
+void expectSameScene(const Scene& a, const Scene& b) {
+  EXPECT_EQ(a.name, b.name);
+  expectSame(a.gravity, b.gravity, "gravity");
+  EXPECT_EQ(a.duration, b.duration);
+  EXPECT_EQ(a.seed, b.seed);
+  ASSERT_EQ(a.fixtures.size(), b.fixtures.size());
+  for (std::size_t i = 0; i < a.fixtures.size(); ++i) {
+    const Fixture &fa = a.fixtures[i], &fb = b.fixtures[i];
+    const std::string w = "fixtures[" + std::to_string(i) + "]";
+    EXPECT_EQ(fa.name, fb.name) << w;
+    ASSERT_EQ(fa.geoms.size(), fb.geoms.size()) << w;
+    for (std::size_t g = 0; g < fa.geoms.size(); ++g) {
+      const Shape &sa = fa.geoms[g].shape, &sb = fb.geoms[g].shape;
+      const std::string wg = w + ".geoms[" + std::to_string(g) + "]";
+      ASSERT_EQ(sa.kind, sb.kind) << wg;
+      switch (sa.kind) {
+        case Shape::Kind::Box:
+          expectSame(sa.size, sb.size, wg + ".size");
+          break;
+        case Shape::Kind::Sphere:
+          EXPECT_EQ(sa.radius, sb.radius) << wg;
+          break;
+        case Shape::Kind::Cylinder:
+        case Shape::Kind::Capsule:
+          EXPECT_EQ(sa.radius, sb.radius) << wg;
+          EXPECT_EQ(sa.length, sb.length) << wg;
+          break;
+        case Shape::Kind::Plane:
+          expectSame(sa.plane_normal, sb.plane_normal, wg + ".normal");
+          EXPECT_EQ(sa.plane_offset, sb.plane_offset) << wg;
+          break;
+        case Shape::Kind::Mesh:
+          EXPECT_EQ(sa.mesh, sb.mesh) << wg;
+          EXPECT_EQ(sa.mesh_scale, sb.mesh_scale) << wg;
+          break;
+      }
+      if (sa.kind == Shape::Kind::Plane) continue;
+      expectSame(fa.geoms[g].pose.position, fb.geoms[g].pose.position, wg + ".position");
+      for (int k = 0; k < 9; ++k) {
+        EXPECT_NEAR(fa.geoms[g].pose.rotation[k], fb.geoms[g].pose.rotation[k], kRotationTolerance)
+            << wg << ".rotation " << k;
+      }
+    }
+    const FeederLaw &la = fa.law, &lb = fb.law;
+    ASSERT_EQ(la.kind, lb.kind) << w;
+    expectSame(la.drift, lb.drift, w + ".drift");
+    expectSame(la.belt_direction, lb.belt_direction, w + ".belt_direction");
+    EXPECT_EQ(la.belt_speed, lb.belt_speed) << w;
+    const Vibration &va = la.vibration, &vb = lb.vibration;
+    EXPECT_EQ(va.amplitude, vb.amplitude) << w;
+    EXPECT_EQ(va.frequency, vb.frequency) << w;
+    expectSame(va.direction, vb.direction, w + ".vibration.direction");
+    EXPECT_EQ(va.phase, vb.phase) << w;
+    EXPECT_EQ(va.torsion_amplitude, vb.torsion_amplitude) << w;
+    expectSame(va.axis_origin, vb.axis_origin, w + ".axis_origin");
+    expectSame(va.axis_direction, vb.axis_direction, w + ".axis_direction");
+    EXPECT_EQ(la.has_calibrated_drift, lb.has_calibrated_drift) << w;
+    expectSame(la.calibrated_drift, lb.calibrated_drift, w + ".calibrated_drift");
+  }
+  ASSERT_EQ(a.parts.size(), b.parts.size());
+  for (std::size_t i = 0; i < a.parts.size(); ++i) {
+    const PartSpec &pa = a.parts[i], &pb = b.parts[i];
+    const std::string w = "parts[" + std::to_string(i) + "]";
+    EXPECT_EQ(pa.name, pb.name) << w;
+    ASSERT_EQ(pa.shape, pb.shape) << w;
+    const int n = pa.shape == Shape::Kind::Box                                            ? 3
+                  : pa.shape == Shape::Kind::Cylinder || pa.shape == Shape::Kind::Capsule ? 2
+                                                                                          : 1;
+    for (int d = 0; d < n; ++d) expectSame(pa.size[d], pb.size[d], w + ".size");
+    if (pa.shape == Shape::Kind::Mesh) EXPECT_EQ(pa.mesh, pb.mesh) << w;
+    EXPECT_EQ(pa.density, pb.density) << w;
+    expectSame(pa.spawn_min, pb.spawn_min, w + ".spawn_min");
+    expectSame(pa.spawn_max, pb.spawn_max, w + ".spawn_max");
+    EXPECT_EQ(pa.random_orientation, pb.random_orientation) << w;
+    EXPECT_EQ(pa.count, pb.count) << w;
+    EXPECT_EQ(pa.rate, pb.rate) << w;
+    expectSame(pa.initial_velocity, pb.initial_velocity, w + ".initial_velocity");
+  }
+  EXPECT_EQ(a.material.mu, b.material.mu);
+  EXPECT_EQ(a.material.restitution, b.material.restitution);
+  EXPECT_EQ(a.solver.time_step, b.solver.time_step);
+  EXPECT_EQ(a.solver.iterations, b.solver.iterations);
+  EXPECT_EQ(a.solver.ode_quickstep, b.solver.ode_quickstep);
+  EXPECT_EQ(a.solver.erp, b.solver.erp);
+  EXPECT_EQ(a.solver.cfm, b.solver.cfm);
+  EXPECT_EQ(a.solver.tolerance, b.solver.tolerance);
+  EXPECT_EQ(a.solver.apgd, b.solver.apgd);
+  EXPECT_EQ(a.solver.coulomb_iterations, b.solver.coulomb_iterations);
+  EXPECT_EQ(a.solver.max_correcting_velocity, b.solver.max_correcting_velocity);
+  EXPECT_EQ(a.removal_height, b.removal_height);
+  const Outputs &oa = a.outputs, &ob = b.outputs;
+  expectSame(oa.conveying_direction, ob.conveying_direction, "conveying_direction");
+  EXPECT_EQ(oa.angular_drift, ob.angular_drift);
+  expectSame(oa.axis_origin, ob.axis_origin, "outputs.axis_origin");
+  expectSame(oa.axis_direction, ob.axis_direction, "outputs.axis_direction");
+  EXPECT_EQ(oa.exit_plane, ob.exit_plane);
+  expectSame(oa.exit_point, ob.exit_point, "exit_point");
+  expectSame(oa.exit_normal, ob.exit_normal, "exit_normal");
+  EXPECT_EQ(oa.sample_interval, ob.sample_interval);
+  EXPECT_EQ(oa.warmup, ob.warmup);
+}
+
+// A scene that sets every field away from its default.
+Scene everyFieldScene() {
+  Scene s;
+  s.name = "every field";
+  s.gravity = {0.1, -0.2, -9.7};
+  s.removal_height = -0.75;
+  s.solver.max_correcting_velocity = 0.25;
+  s.solver.coulomb_iterations = 3;
+  s.duration = 2.5;
+  s.seed = 18446744073709551557ull;  // needs all 64 bits
+  const double c = std::cos(0.3), sn = std::sin(0.3);
+
+  Fixture belt;
+  belt.name = "belt";
+  Fixture::Geom g;
+  g.shape.kind = Shape::Kind::Box;
+  g.shape.size = {2, 0.5, 0.02};
+  g.pose.position = {0.1, 0.2, -0.01};
+  const double ry[9] = {c, 0, sn, 0, 1, 0, -sn, 0, c};  // 0.3 rad about y
+  std::copy(ry, ry + 9, g.pose.rotation);
+  belt.geoms.push_back(g);
+  belt.law.kind = FeederLaw::Kind::Belt;
+  belt.law.belt_direction = {c, sn, 0};
+  belt.law.belt_speed = -0.25;
+  s.fixtures.push_back(belt);
+
+  Fixture table;
+  table.name = "turntable";
+  Fixture::Geom cyl;
+  cyl.shape.kind = Shape::Kind::Cylinder;
+  cyl.shape.radius = 0.4;
+  cyl.shape.length = 0.05;
+  cyl.pose.position = {3, 0, -0.025};
+  table.geoms.push_back(cyl);
+  Fixture::Geom cap;
+  cap.shape.kind = Shape::Kind::Capsule;
+  cap.shape.radius = 0.01;
+  cap.shape.length = 0.3;
+  cap.pose.position = {3, 0.5, 0.01};
+  table.geoms.push_back(cap);
+  table.law.kind = FeederLaw::Kind::Drift;
+  table.law.drift = {{0.01, 0, 0.002}, {0, 0, 1.5}, {3, 0, 0}};
+  s.fixtures.push_back(table);
+
+  Fixture bowl;
+  bowl.name = "bowl";
+  Fixture::Geom mesh;
+  mesh.shape.kind = Shape::Kind::Mesh;
+  mesh.shape.mesh = "/meshes/bowl.stl";
+  mesh.shape.mesh_scale = 0.001;
+  mesh.pose.position = {-3, 0, 0};
+  const double rz[9] = {c, -sn, 0, sn, c, 0, 0, 0, 1};
+  std::copy(rz, rz + 9, mesh.pose.rotation);
+  bowl.geoms.push_back(mesh);
+  Fixture::Geom ball;
+  ball.shape.kind = Shape::Kind::Sphere;
+  ball.shape.radius = 0.02;
+  ball.pose.position = {-3, 0, 0.5};
+  bowl.geoms.push_back(ball);
+  bowl.law.kind = FeederLaw::Kind::Vibration;
+  Vibration& v = bowl.law.vibration;
+  v.amplitude = 1.5e-4;
+  v.frequency = 50;
+  v.direction = {0, 0, 1};
+  v.phase = 0.1;
+  v.torsion_amplitude = 0.003;
+  v.axis_origin = {-3, 0, 0};
+  v.axis_direction = {0, 0, 1};
+  bowl.law.has_calibrated_drift = true;
+  bowl.law.calibrated_drift = {{0, 0, 0.0019}, {0, 0, 0.4}, {-3, 0, 0}};
+  s.fixtures.push_back(bowl);
+
+  Fixture ground;
+  ground.name = "ground";
+  Fixture::Geom plane;
+  plane.shape.kind = Shape::Kind::Plane;
+  plane.shape.plane_normal = {0, 0, 1};
+  plane.shape.plane_offset = -1;
+  ground.geoms.push_back(plane);
+  s.fixtures.push_back(ground);
+
+  PartSpec boxes;
+  boxes.name = "boxes";
+  boxes.shape = Shape::Kind::Box;
+  boxes.size[0] = {0.02, 0.002, 0.015, 0.025};
+  boxes.size[1] = {0.03, 0, 0, 1e300};
+  boxes.size[2] = {0.01, 0.001, 0.005, 1e300};
+  boxes.density = 2700;
+  boxes.spawn_min = {-0.9, -0.2, 0.05};
+  boxes.spawn_max = {-0.5, 0.2, 0.3};
+  boxes.random_orientation = true;
+  boxes.count = 20;
+  boxes.rate = 10;
+  boxes.initial_velocity = {0.1, 0, -0.2};
+  s.parts.push_back(boxes);
+  PartSpec balls;
+  balls.name = "balls";
+  balls.shape = Shape::Kind::Sphere;
+  balls.size[0] = {0.005, 0, 0, 1e300};
+  balls.spawn_min = {0, 0, 1};
+  balls.spawn_max = {0.3, 0.3, 1.3};
+  balls.count = 3;
+  s.parts.push_back(balls);
+  PartSpec pins;
+  pins.name = "pins";
+  pins.shape = Shape::Kind::Capsule;
+  pins.size[0] = {0.003, 0, 0, 1e300};
+  pins.size[1] = {0.02, 0.001, 0.01, 0.03};
+  pins.spawn_min = {0, 1, 1};
+  pins.spawn_max = {0.3, 1.3, 1.3};
+  s.parts.push_back(pins);
+  PartSpec nuts;
+  nuts.name = "nuts";
+  nuts.shape = Shape::Kind::Mesh;
+  nuts.mesh = "/meshes/nut.obj";
+  nuts.size[0] = {0.5, 0.05, 0.4, 0.6};
+  nuts.density = 7850;
+  nuts.spawn_min = {-3, 0, 1};
+  nuts.spawn_max = {-2.5, 0.5, 1.5};
+  nuts.count = 4;
+  s.parts.push_back(nuts);
+
+  s.material = {0.35, 0.2};
+  s.solver = {0.002, 77, false, 0.3, 1e-6, 1e-8, false, 3};
+  s.outputs.conveying_direction = {0, 1, 0};
+  s.outputs.angular_drift = true;
+  s.outputs.axis_origin = {-3, 0, 0};
+  s.outputs.axis_direction = {0, 0, -1};
+  s.outputs.exit_plane = true;
+  s.outputs.exit_point = {1.1, 0, 0};
+  s.outputs.exit_normal = {1, 0, 0};
+  s.outputs.sample_interval = 0.02;
+  s.outputs.warmup = 0.5;
+  return s;
+}
+
+TEST(SceneFile, RoundTripKeepsEveryField) {
+  const Scene original = everyFieldScene();
+  CountingLoader meshes;
+  const std::string text = toJson(original);
+  const Scene back = parseScene(text, "round_trip.json", meshes.loader());
+  expectSameScene(original, back);
+  EXPECT_EQ(toJson(back), text);  // and the text is stable
+  EXPECT_EQ(meshes.calls, 2);     // bowl (scale 0.001) and nut (scale 1), each once
+  ASSERT_TRUE(back.fixtures[2].geoms[0].shape.mesh_data);
+  ASSERT_TRUE(back.parts[3].mesh_data);
+}
+
+TEST(SceneFile, PartMeshIsCentredOnItsCentreOfMass) {
+  const Scene back = parseScene(toJson(everyFieldScene()), "x.json", CountingLoader{}.loader());
+  const MassProperties p = massProperties(*back.parts[3].mesh_data, 1.0);
+  EXPECT_NEAR(norm(p.centre_of_mass), 0.0, 1e-12);  // the test box sits at (0.1, -0.05, 0.2)
+  // The fixture mesh keeps its own frame, scaled by 0.001.
+  const MassProperties f = massProperties(*back.fixtures[2].geoms[0].shape.mesh_data, 1.0);
+  EXPECT_NEAR(f.centre_of_mass.x, 0.1e-3, 1e-9);
+}
+
+TEST(SceneFile, SceneWithoutMeshesNeverCallsTheMeshLoader) {
+  Scene s = everyFieldScene();
+  s.fixtures.erase(s.fixtures.begin() + 2);  // the bowl
+  s.parts.pop_back();                        // the nuts
+  int calls = 0;
+  const MeshLoader counting = [&calls](const fs::path&, double) {
+    ++calls;
+    return TriangleMesh{};
+  };
+  const Scene back = parseScene(toJson(s), "no_meshes.json", counting);
+  EXPECT_EQ(calls, 0);
+  EXPECT_FALSE(back.hasMeshes());
+}
+
+TEST(SceneFile, RelativeMeshPathsResolveAgainstTheSceneFolder) {
+  const std::string text = R"({
+    "fixtures": [{"geoms": [{"shape": "mesh", "mesh": "../meshes/floor.obj", "scale": 2}]}],
+    "parts": [{"shape": "sphere", "size": [0.01], "spawn_min": [0, 0, 1], "spawn_max": [0, 0, 1]}]
+  })";
+  fs::path asked;
+  double asked_scale = 0;
+  const MeshLoader loader = [&](const fs::path& file, double scale) {
+    asked = file;
+    asked_scale = scale;
+    return loadTriangleMesh(kData / "floor_slab.obj", scale);
+  };
+  const Scene s = parseScene(text, "/work/scenes/demo.json", loader);
+  EXPECT_EQ(asked, fs::path("/work/meshes/floor.obj"));
+  EXPECT_EQ(asked_scale, 2.0);
+  EXPECT_EQ(s.fixtures[0].geoms[0].shape.mesh, "/work/meshes/floor.obj");
+}
+
+TEST(SceneFile, ShorthandsAndAnglesWithUnitsInTheKey) {
+  const std::string text = R"({
+    "comment": "comments are allowed in every object",
+    "fixtures": [{
+      "geoms": [{"shape": "box", "size": [1, 0.1, 0.02],
+                 "rotation": {"axis": [0, 0, 2], "angle_deg": 90}}],
+      "law": {"vibration": {"amplitude": 2e-4, "frequency": 50, "angle_deg": 30,
+                            "phase_deg": 180},
+              "calibrated_drift": {"linear": [0.05, 0, 0]}}
+    }, {
+      "geoms": [{"shape": "cylinder", "radius": 0.15, "length": 0.01}],
+      "law": {"screw": {"vertical_amplitude": 1e-4, "torsion_amplitude_deg": 0.2,
+                        "frequency": 60, "axis_origin": [0, 0, 0]}}
+    }],
+    "parts": [{"shape": "box", "size": [0.02, {"mean": 0.02, "stddev": 0.002}, 0.005],
+               "spawn_min": [0, 0, 0.01], "spawn_max": [0, 0, 0.01]}]
+  })";
+  const Scene s = parseScene(text, "short.json");
+  const Pose& pose = s.fixtures[0].geoms[0].pose;
+  EXPECT_NEAR(pose.rotation[1], -1, 1e-15);  // 90 degrees about +z: x -> y
+  EXPECT_NEAR(pose.rotation[3], 1, 1e-15);
+  const Vibration& v = s.fixtures[0].law.vibration;
+  EXPECT_NEAR(v.direction.x, std::sqrt(3.0) / 2, 1e-15);
+  EXPECT_NEAR(v.direction.z, 0.5, 1e-15);
+  EXPECT_NEAR(v.phase, kPi, 1e-15);
+  EXPECT_TRUE(s.fixtures[0].law.has_calibrated_drift);
+  const Vibration& screw = s.fixtures[1].law.vibration;
+  EXPECT_EQ(screw.amplitude, 1e-4);
+  EXPECT_NEAR(screw.torsion_amplitude, 0.2 * kPi / 180, 1e-18);
+  expectSame(screw.direction, {0, 0, 1}, "screw direction is the axis");
+  EXPECT_EQ(s.parts[0].size[1].stddev, 0.002);
+  EXPECT_EQ(s.parts[0].size[0].stddev, 0.0);
+  // Defaults for everything omitted.
+  EXPECT_EQ(s.solver.time_step, SolverSettings{}.time_step);
+  EXPECT_EQ(s.duration, Scene{}.duration);
+  EXPECT_EQ(s.parts[0].count, 1);
+}
+
+// ---- Refused input -----------------------------------------------------------------------------
+
+// A valid scene; the tests break one value each.
+const char* kGood = R"({
+  "fixtures": [{"name": "track",
+                "geoms": [{"shape": "box", "size": [1, 0.1, 0.02], "position": [0, 0, -0.01]}],
+                "law": {"vibration": {"amplitude": 2e-4, "frequency": 50, "angle_deg": 20}}}],
+  "parts": [{"shape": "box", "size": [0.02, 0.02, 0.005],
+             "spawn_min": [0, 0, 0.003], "spawn_max": [0, 0, 0.003]},
+            {"shape": "sphere", "size": [0.004],
+             "spawn_min": [0.2, 0, 0.005], "spawn_max": [0.2, 0, 0.005]},
+            {"shape": "cylinder", "size": [0.004, {"mean": 0.01}],
+             "spawn_min": [0.4, 0, 0.01], "spawn_max": [0.4, 0, 0.01]}],
+  "duration": 1
+})";
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+// Parses `text` as "bad.json", expects a SceneFileError at `path` whose problem contains `what`.
+SceneFileError refused(const std::string& text, const std::string& path, const std::string& what) {
+  try {
+    parseScene(text, "bad.json");
+  } catch (const SceneFileError& e) {
+    EXPECT_EQ(e.path(), path) << e.what();
+    EXPECT_NE(e.problem().find(what), std::string::npos) << e.what();
+    EXPECT_EQ(e.source(), "bad.json");
+    EXPECT_EQ(std::string(e.what()).rfind("bad.json", 0), 0u) << e.what();
+    return e;
+  }
+  ADD_FAILURE() << "accepted; expected " << path << ": " << what;
+  return SceneFileError("", "", "");
+}
+
+TEST(SceneFileErrors, TheGoodSceneIsAccepted) {
+  EXPECT_NO_THROW(parseScene(kGood, "good.json"));
+}
+
+TEST(SceneFileErrors, MissingRequiredKeyNamesIt) {
+  refused(replaced(kGood, R"({"shape": "sphere", )", "{"), "parts[1].shape",
+          "missing required key");
+  refused(replaced(kGood, R"("parts")", R"("prts")"), "parts", "\"prts\" a typo");
+  refused(replaced(kGood, R"("frequency": 50)", R"("frequncy": 50)"),
+          "fixtures[0].law.vibration.frequency", "missing required key");
+}
+
+TEST(SceneFileErrors, WrongTypeNamesTheValue) {
+  const SceneFileError e =
+      refused(replaced(kGood, R"("frequency": 50)", R"("frequency": "fifty")"),
+              "fixtures[0].law.vibration.frequency", "expected a number, got \"fifty\"");
+  EXPECT_EQ(std::string(e.what()),
+            "bad.json: fixtures[0].law.vibration.frequency: expected a number, got \"fifty\"");
+  refused(replaced(kGood, R"("size": [0.004])", R"("size": [true])"), "parts[1].size[0]",
+          "expected a number or {\"mean\": ..., \"stddev\": ...}, got true");
+  refused(replaced(kGood, R"("position": [0, 0, -0.01])", R"("position": [0, -0.01])"),
+          "fixtures[0].geoms[0].position", "expected [x, y, z]");
+  refused(replaced(kGood, R"("duration": 1)", R"("duration": {"s": 1})"), "duration",
+          "expected a number, got an object");
+  refused(replaced(kGood, R"("name": "track")", R"("name": 7)"), "fixtures[0].name",
+          "expected a string, got 7");
+  refused(R"({"parts": {}})", "parts", "expected an array");
+  refused("[1, 2]", "", "expected an object, got an array");
+}
+
+TEST(SceneFileErrors, OutOfRangeValuesNameThePath) {
+  refused(
+      replaced(kGood, R"("size": [0.004, {"mean": 0.01}])", R"("size": [0.004, {"mean": -0.01}])"),
+      "parts[2].size[1].mean", "must be > 0");
+  refused(replaced(kGood, R"("size": [0.02, 0.02, 0.005])", R"("size": [0.02, -0.02, 0.005])"),
+          "parts[0].size[1]", "must be > 0");
+  refused(replaced(kGood, R"("size": [1, 0.1, 0.02])", R"("size": [1, 0, 0.02])"),
+          "fixtures[0].geoms[0].size[1]", "must be > 0");
+  refused(replaced(kGood, R"("duration": 1)", R"("duration": 1, "material": {"restitution": 2})"),
+          "material.restitution", "must be in [0, 1]");
+  refused(replaced(kGood, R"("duration": 1)", R"("duration": 1, "solver": {"iterations": 2.5})"),
+          "solver.iterations", "expected an integer");
+  refused(replaced(kGood, R"("duration": 1)", R"("duration": 1, "solver": {"iterations": 0})"),
+          "solver.iterations", "must be >= 1");
+  refused(replaced(kGood, R"("size": [0.004, {"mean": 0.01}])",
+                   R"("size": [0.004, {"mean": 0.01, "min": 0.02, "max": 0.01}])"),
+          "parts[2].size[1].max", "must exceed min");  // from Scene::validate()
+  refused(replaced(kGood, R"("spawn_max": [0, 0, 0.003])", R"("spawn_max": [0, 0, 0.001])"),
+          "parts[0].spawn_max", "spawn_min");  // from Scene::validate()
+  refused(replaced(kGood, R"("angle_deg": 20)", R"("angle_deg": 20, "direction": [1, 0, 0])"),
+          "fixtures[0].law.vibration.direction", "not both");
+  refused(replaced(kGood, R"("angle_deg": 20)", R"("angle_deg": 20, "angle_rad": 0.3)"),
+          "fixtures[0].law.vibration.angle_deg", "not both");
+  refused(replaced(kGood, R"("position": [0, 0, -0.01])",
+                   R"("rotation": {"axis": [0, 0, 0], "angle_deg": 5})"),
+          "fixtures[0].geoms[0].rotation.axis", "zero vector");
+}
+
+TEST(SceneFileErrors, OverflowingNumberIsRefusedAsNotFinite) {
+  const std::string text = replaced(kGood, R"("duration": 1)", R"("duration": 1e999)");
+  const SceneFileError e = refused(text, "duration", "not finite");
+  const std::string before = text.substr(0, text.find("1e999"));
+  EXPECT_EQ(e.line(), 1 + std::count(before.begin(), before.end(), '\n'));
+  refused(replaced(kGood, R"("size": [0.004])", R"("size": [-1e999])"), "parts[1].size[0]",
+          "not finite");
+}
+
+TEST(SceneFileErrors, UnknownKeyIsRefusedWithASuggestion) {
+  refused(replaced(kGood, R"("duration": 1)", R"("duration": 1, "material": {"restitusion": 0.1})"),
+          "material.restitusion", "did you mean \"restitution\"");
+  refused(replaced(kGood, R"("size": [0.004])", R"("size": [0.004], "radius": 0.004)"),
+          "parts[1].radius", "unknown key");
+  refused(replaced(kGood, R"("duration": 1)", R"("duration": 1, "durration": 2)"), "durration",
+          "did you mean \"duration\"");
+  // A key of another shape is unknown for this one.
+  refused(replaced(kGood, R"("size": [1, 0.1, 0.02])", R"("size": [1, 0.1, 0.02], "radius": 1)"),
+          "fixtures[0].geoms[0].radius", "unknown key");
+}
+
+TEST(SceneFileErrors, DuplicateKeyIsRefused) {
+  refused(replaced(kGood, R"("duration": 1)", R"("duration": 1, "duration": 2)"), "duration",
+          "duplicate key");
+  refused(replaced(kGood, R"("frequency": 50)", R"("frequency": 50, "frequency": 60)"),
+          "fixtures[0].law.vibration.frequency", "duplicate key");
+}
+
+TEST(SceneFileErrors, SyntaxErrorReportsLineAndColumn) {
+  const std::string text =
+      "{\n  \"parts\": [\n    {\"shape\": \"box\"}\n    {\"shape\": \"box\"}\n]}";
+  const SceneFileError e = refused(text, "", "syntax error");
+  EXPECT_EQ(e.line(), 4);
+  EXPECT_GT(e.column(), 0);
+  EXPECT_EQ(std::string(e.what()).rfind("bad.json:4:", 0), 0u) << e.what();
+  refused("", "", "syntax error");
+  refused("{\"parts\": [] ", "", "syntax error");
+}
+
+TEST(SceneFileErrors, BadLawAndShapeNamesAreExplained) {
+  refused(replaced(kGood, R"("shape": "sphere")", R"("shape": "ball")"), "parts[1].shape",
+          "expected box, sphere");
+  refused(replaced(kGood, R"("shape": "sphere")", R"("shape": "plane")"), "parts[1].shape",
+          "cannot be a plane");
+  refused(replaced(kGood, R"("law": {)", R"("law": {"drift": {}, )"), "fixtures[0].law.vibration",
+          "one kind");
+  refused(replaced(kGood, R"("law": {"vibration")", R"("law": {"vibrations")"), "fixtures[0].law",
+          "expected one of");
+  refused(
+      replaced(kGood,
+               R"("law": {"vibration": {"amplitude": 2e-4, "frequency": 50, "angle_deg": 20}})",
+               R"("law": {"belt": {"direction": [1, 0, 0], "speed": 1}, "calibrated_drift": {}})"),
+      "fixtures[0].law.calibrated_drift", "only a vibration or screw");
+  refused(replaced(kGood, R"("amplitude": 2e-4, )", ""), "fixtures[0].law.vibration.amplitude",
+          "needs an amplitude");  // from Scene::validate()
+  refused(replaced(kGood, R"("size": [0.004])", R"("size": [0.004, 0.01])"), "parts[1].size",
+          "needs an array of 1");
+  refused(replaced(kGood, R"("duration": 1)", R"("duration": 1, "format_version": 2)"),
+          "format_version", "reads version 1");
+}
+
+TEST(SceneFileErrors, PlaneTakesNoPose) {
+  refused(replaced(kGood, R"({"shape": "box", "size": [1, 0.1, 0.02], "position": [0, 0, -0.01]})",
+                   R"({"shape": "plane", "normal": [0, 0, 1], "position": [0, 0, 0]})"),
+          "fixtures[0].geoms[0].position", "unknown key");
+}
+
+TEST(SceneFileErrors, MeshProblemsNameTheGeomAndTheFile) {
+  const std::string text = R"({
+    "fixtures": [{"geoms": [{"shape": "mesh", "mesh": "garbage.stl"}]}],
+    "parts": [{"shape": "mesh", "mesh": "box_open.obj",
+               "spawn_min": [0, 0, 1], "spawn_max": [0, 0, 1]}]
+  })";
+  const std::string source = (kData / "scene.json").string();
+  try {
+    parseScene(text, source);
+    ADD_FAILURE() << "accepted";
+  } catch (const SceneFileError& e) {
+    EXPECT_EQ(e.path(), "fixtures[0].geoms[0].mesh");
+    EXPECT_NE(e.problem().find("garbage.stl"), std::string::npos) << e.what();
+  }
+  try {
+    parseScene(replaced(text, "garbage.stl", "box_20x30x40mm.stl"), source);
+    ADD_FAILURE() << "accepted";
+  } catch (const SceneFileError& e) {
+    EXPECT_EQ(e.path(), "parts[0].mesh");
+    EXPECT_NE(e.problem().find("not closed"), std::string::npos) << e.what();
+  }
+  try {
+    parseScene(replaced(text, "garbage.stl", "missing.stl"), source);
+    ADD_FAILURE() << "accepted";
+  } catch (const SceneFileError& e) {
+    EXPECT_NE(e.problem().find("file not found"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneFileErrors, UnreadableFileIsRefusedWithItsName) {
+  try {
+    loadScene(kData / "no_such_scene.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const SceneFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_scene.json"), std::string::npos);
+    EXPECT_NE(e.problem().find("cannot open"), std::string::npos);
+  }
+}
+
+TEST(SceneFile, LoadSceneReadsAFile) {
+  const fs::path file = fs::path(testing::TempDir()) / "rheofeed_io_load_scene.json";
+  std::ofstream(file) << kGood;
+  const Scene s = loadScene(file);
+  EXPECT_EQ(s.fixtures[0].name, "track");
+  EXPECT_EQ(s.parts.size(), 3u);
+  fs::remove(file);
+}
+
+}  // namespace
+}  // namespace rheofeed::scene
