@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "rheofeed/scene/calibration.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <stdexcept>
@@ -34,7 +35,7 @@ Calibration calibrateBySampling(const Scene& scene, int fixture,
   Scene sample = scene;
   sample.name = scene.name + "_calibration";
   sample.parts.resize(1);
-  sample.parts[0].count = settings.sample_parts;
+  sample.parts[0].count = std::min(settings.sample_parts, scene.parts[0].count);
   sample.parts[0].rate = 0;
   sample.solver.time_step = 1.0 / (v.frequency * settings.steps_per_cycle);
   sample.duration = (settings.warmup_cycles + settings.measure_cycles) / v.frequency;

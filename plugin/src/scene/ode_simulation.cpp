@@ -18,10 +18,9 @@
 namespace rheofeed::scene {
 namespace {
 
-class OdeSimulation final : public Simulation {
+class OdeSimulation final : public PartSimulation {
  public:
-  OdeSimulation(const Scene& scene, Method method)
-      : scene_(scene), method_(method), instances_(drawParts(scene)) {
+  OdeSimulation(const Scene& scene, Method method) : PartSimulation(scene, method) {
     static const bool initialised = (dInitODE2(0), true);
     (void)initialised;
     world_ = dWorldCreate();
@@ -54,7 +53,7 @@ class OdeSimulation final : public Simulation {
         } else if (f.law.kind != FeederLaw::Kind::None) {
           feeders_->add(geom, rheonomicLaw(f));
         }
-        fixture_geoms_.insert(geom);
+        addFixtureGeom(geom);
       }
     }
 
@@ -80,36 +79,21 @@ class OdeSimulation final : public Simulation {
     dWorldDestroy(world_);
   }
 
-  void step() override {
-    const double h = scene_.solver.time_step;
-    for (const auto& [body, vibration] : vibrating_) driveKinematic(body, vibration, time_, h);
-    collider_->collide(space_, time_);
+  // The time at the start of the step is needed by the kinematic law and the plugin.
+  void advance(double h) override {
+    const double t = time();
+    for (const auto& [body, vibration] : vibrating_) driveKinematic(body, vibration, t, h);
+    collider_->collide(space_, t);
     if (scene_.solver.ode_quickstep) {
       dWorldQuickStep(world_, h);
     } else {
       dWorldStep(world_, h);
     }
-    time_ = ++steps_ * h;
-    for (std::size_t i = 0; i < parts_.size(); ++i) {
-      if (!active_[i]) continue;
-      const Vec3 x = vec(dBodyGetPosition(parts_[i]));
-      checkPart(static_cast<int>(i), x, method_, time_);
-      if (x.z < scene_.removal_height) {  // left the scene: out of the simulation for good
-        dBodyDisable(parts_[i]);
-        dGeomDisable(dBodyGetFirstGeom(parts_[i]));
-        active_[i] = false;
-      }
-    }
-    collectTotals(h);
-    spawnDue();
   }
 
-  double time() const override { return time_; }
-  int numParts() const override { return static_cast<int>(parts_.size()); }
-  PartState part(int i) const override {
+  PartState partState(int i) const override {
     dBodyID b = parts_.at(static_cast<std::size_t>(i));
     PartState s;
-    s.active = active_.at(static_cast<std::size_t>(i));
     s.position = vec(dBodyGetPosition(b));
     s.velocity = vec(dBodyGetLinearVel(b));
     s.angular_velocity = vec(dBodyGetAngularVel(b));
@@ -119,9 +103,12 @@ class OdeSimulation final : public Simulation {
     }
     return s;
   }
-  double partMass(int i) const override { return instances_.at(static_cast<std::size_t>(i)).mass; }
-  ContactTotals contactTotals() const override { return totals_; }
-  Method method() const override { return method_; }
+
+  void removePart(int i) override {
+    dBodyID b = parts_.at(static_cast<std::size_t>(i));
+    dBodyDisable(b);
+    dGeomDisable(dBodyGetFirstGeom(b));
+  }
 
  private:
   static Vec3 vec(const dReal* a) { return {a[0], a[1], a[2]}; }
@@ -145,58 +132,45 @@ class OdeSimulation final : public Simulation {
     dBodySetAngularVel(body, ang.x, ang.y, ang.z);
   }
 
-  void spawnDue() {
-    while (next_ < instances_.size() && instances_[next_].spawn_time <= time_ + 1e-12) {
-      const PartInstance& p = instances_[next_++];
-      dBodyID b = dBodyCreate(world_);
-      dMass m;
-      dMassSetParameters(&m, p.mass, 0, 0, 0, p.inertia[0], p.inertia[4], p.inertia[8],
-                         p.inertia[1], p.inertia[2], p.inertia[5]);
-      dBodySetMass(b, &m);
-      dBodySetPosition(b, p.pose.position.x, p.pose.position.y, p.pose.position.z);
-      dMatrix3 r;
-      toOdeMatrix(p.pose, r);
-      dBodySetRotation(b, r);
-      dBodySetLinearVel(b, p.velocity.x, p.velocity.y, p.velocity.z);
-      dGeomSetBody(createGeom(space_, p.shape, meshes_), b);
-      parts_.push_back(b);
-      active_.push_back(true);
-    }
+  void addPart(const PartInstance& p) override {
+    dBodyID b = dBodyCreate(world_);
+    dMass m;
+    dMassSetParameters(&m, p.mass, 0, 0, 0, p.inertia[0], p.inertia[4], p.inertia[8], p.inertia[1],
+                       p.inertia[2], p.inertia[5]);
+    dBodySetMass(b, &m);
+    dBodySetPosition(b, p.pose.position.x, p.pose.position.y, p.pose.position.z);
+    dMatrix3 r;
+    toOdeMatrix(p.pose, r);
+    dBodySetRotation(b, r);
+    dBodySetLinearVel(b, p.velocity.x, p.velocity.y, p.velocity.z);
+    dGeomSetBody(createGeom(space_, p.shape, meshes_), b);
+    parts_.push_back(b);
   }
 
-  // Impulses from fixtures on parts over the last step.
-  void collectTotals(double h) {
-    totals_ = {};
+  ContactTotals fixtureImpulses(double h) const override {
+    ContactTotals totals;
     for (const ContactCollider::Joint& j : collider_->joints()) {
-      const bool f1 = fixture_geoms_.count(j.g1) != 0, f2 = fixture_geoms_.count(j.g2) != 0;
+      const bool f1 = isFixture(j.g1), f2 = isFixture(j.g2);
       if (f1 == f2 || !j.feedback) continue;  // part-part or fixture-fixture
       const dGeomID part = f1 ? j.g2 : j.g1;
       const dBodyID body = dGeomGetBody(part);
       const dReal* f = dJointGetBody(j.joint, 0) == body ? j.feedback->f1 : j.feedback->f2;
       const Vec3 impulse = h * vec(f);
       const Vec3 n_into_part = part == j.g1 ? j.normal : -j.normal;
-      ++totals_.count;
-      totals_.normal_impulse += dot(impulse, n_into_part);
-      totals_.impulse = totals_.impulse + impulse;
+      ++totals.count;
+      totals.normal_impulse += dot(impulse, n_into_part);
+      totals.impulse = totals.impulse + impulse;
     }
+    return totals;
   }
 
-  Scene scene_;
-  Method method_;
-  std::vector<PartInstance> instances_;
-  std::size_t next_ = 0;
   TriMeshStore meshes_;  // trimesh data of the mesh geoms; outlives space_ (see the destructor)
   dWorldID world_;
   dSpaceID space_;
   std::unique_ptr<FeederSet> feeders_;
   std::unique_ptr<ContactCollider> collider_;
   std::vector<std::pair<dBodyID, Vibration>> vibrating_;
-  std::unordered_set<dGeomID> fixture_geoms_;
   std::vector<dBodyID> parts_;
-  std::vector<bool> active_;
-  double time_ = 0;
-  long steps_ = 0;
-  ContactTotals totals_;
 };
 
 }  // namespace

@@ -12,10 +12,9 @@ namespace {
 
 using reference::BodyId;
 
-class ReferenceSimulation final : public Simulation {
+class ReferenceSimulation final : public PartSimulation {
  public:
-  ReferenceSimulation(const Scene& scene, Method method)
-      : scene_(scene), method_(method), instances_(drawParts(scene)) {
+  ReferenceSimulation(const Scene& scene, Method method) : PartSimulation(scene, method) {
     reference::Settings s;
     s.gravity = scene.gravity;
     s.erp = scene.solver.erp;
@@ -43,35 +42,19 @@ class ReferenceSimulation final : public Simulation {
         } else if (f.law.kind != FeederLaw::Kind::None) {
           world_->setFeeder(geom, rheonomicLaw(f));
         }
-        fixture_geoms_.insert(geom);
+        addFixtureGeom(geom);
       }
     }
     spawnDue();
   }
 
-  void step() override {
-    const double h = scene_.solver.time_step;
-    world_->step(h);
-    time_ = ++steps_ * h;
-    for (std::size_t i = 0; i < parts_.size(); ++i) {
-      if (!active_[i]) continue;
-      const Vec3 x = world_->state(parts_[i]).position;
-      checkPart(static_cast<int>(i), x, method_, time_);
-      if (x.z < scene_.removal_height) {
-        world_->disableBody(parts_[i]);
-        active_[i] = false;
-      }
-    }
-    collectTotals();
-    spawnDue();
-  }
+  void advance(double h) override { world_->step(h); }
 
-  double time() const override { return time_; }
-  int numParts() const override { return static_cast<int>(parts_.size()); }
-  PartState part(int i) const override {
+  void removePart(int i) override { world_->disableBody(parts_.at(static_cast<std::size_t>(i))); }
+
+  PartState partState(int i) const override {
     const reference::BodyState& b = world_->state(parts_.at(static_cast<std::size_t>(i)));
     PartState s;
-    s.active = active_.at(static_cast<std::size_t>(i));
     s.position = b.position;
     s.velocity = b.linear_velocity;
     s.angular_velocity = b.angular_velocity;
@@ -88,23 +71,16 @@ class ReferenceSimulation final : public Simulation {
     r[8] = 1 - 2 * (q.x * q.x + q.y * q.y);
     return s;
   }
-  double partMass(int i) const override { return instances_.at(static_cast<std::size_t>(i)).mass; }
-  ContactTotals contactTotals() const override { return totals_; }
-  Method method() const override { return method_; }
 
  private:
-  void spawnDue() {
-    while (next_ < instances_.size() && instances_[next_].spawn_time <= time_ + 1e-12) {
-      const PartInstance& p = instances_[next_++];
-      reference::BodyState state;
-      state.position = p.pose.position;
-      state.linear_velocity = p.velocity;
-      state.orientation = quatOf(p.pose);
-      const BodyId body = world_->addBody(p.mass, p.inertia, state);
-      world_->attachGeom(createGeom(world_->space(), p.shape, meshes_), body);
-      parts_.push_back(body);
-      active_.push_back(true);
-    }
+  void addPart(const PartInstance& p) override {
+    reference::BodyState state;
+    state.position = p.pose.position;
+    state.linear_velocity = p.velocity;
+    state.orientation = quatOf(p.pose);
+    const BodyId body = world_->addBody(p.mass, p.inertia, state);
+    world_->attachGeom(createGeom(world_->space(), p.shape, meshes_), body);
+    parts_.push_back(body);
   }
 
   static reference::Quat quatOf(const Pose& pose) {
@@ -127,32 +103,24 @@ class ReferenceSimulation final : public Simulation {
     return q;
   }
 
-  void collectTotals() {
-    totals_ = {};
+  ContactTotals fixtureImpulses(double) const override {
+    ContactTotals totals;
     for (const reference::ContactImpulse& c : world_->contacts()) {
-      const bool f1 = fixture_geoms_.count(c.g1) != 0, f2 = fixture_geoms_.count(c.g2) != 0;
+      const bool f1 = isFixture(c.g1), f2 = isFixture(c.g2);
       if (f1 == f2) continue;
       // Impulse on body1 (g1) is gamma_n n + gamma_t; on g2 its opposite.
       const Vec3 on_g1 = c.normal_impulse * c.normal + c.tangential_impulse;
       const Vec3 impulse = f1 ? -on_g1 : on_g1;
-      ++totals_.count;
-      totals_.normal_impulse += c.normal_impulse;
-      totals_.impulse = totals_.impulse + impulse;
+      ++totals.count;
+      totals.normal_impulse += c.normal_impulse;
+      totals.impulse = totals.impulse + impulse;
     }
+    return totals;
   }
 
-  Scene scene_;
-  Method method_;
-  std::vector<PartInstance> instances_;
-  std::size_t next_ = 0;
   TriMeshStore meshes_;  // declared before world_: destroyed after the world's space and geoms
   std::unique_ptr<reference::World> world_;
-  std::unordered_set<dGeomID> fixture_geoms_;
   std::vector<BodyId> parts_;
-  std::vector<bool> active_;
-  double time_ = 0;
-  long steps_ = 0;
-  ContactTotals totals_;
 };
 
 }  // namespace

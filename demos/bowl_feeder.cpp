@@ -1,0 +1,24 @@
+// SPDX-License-Identifier: MIT
+// Vibratory bowl feeder (draft).
+#include <cstdio>
+#include <exception>
+
+#include "common/demo_runner.hpp"
+#include "rheofeed/scene/scene_io.hpp"
+
+#ifndef RHEOFEED_DEMO_SCENES_DIR
+#error "RHEOFEED_DEMO_SCENES_DIR must name the folder of the built-in scene files"
+#endif
+
+int main(int argc, char** argv) {
+  rheofeed::scene::Scene scene;
+  try {
+    scene = rheofeed::scene::loadScene(RHEOFEED_DEMO_SCENES_DIR "/bowl_feeder.json");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bowl_feeder: built-in scene: %s\n", e.what());
+    return 2;
+  }
+  return rheofeed::demo::runDemo(argc, argv, "bowl_feeder",
+                                 "rheofeed vibratory bowl feeder: helical track, CAD meshes",
+                                 scene);
+}
