@@ -52,8 +52,9 @@ std::vector<Case> cases(int pile) {
     e << "tan(theta) = 0.613 > mu: slides down at a = g (sin - mu cos) = " << a
       << " m/s^2, |v| = " << a * s.duration << " m/s at t = " << s.duration << " s";
     out.push_back({s, e.str(),
-                   "sliding: ODE's friction pyramid (exact along fdir1 = belt direction) vs the "
-                   "cone; CCP relaxation glide (u_n = mu |u_t|) recovered by ERP"});
+                   "sliding along fdir1 = belt direction, where ODE's friction pyramid is exact, "
+                   "so it matches the cone; the reference solves true Coulomb (the relaxed CCP, "
+                   "coulomb_iterations = 0, would launch the part at u_n = mu |u_t|)"});
   }
   {
     Scene s = turntableScene(1.0);
@@ -63,8 +64,8 @@ std::vector<Case> cases(int pile) {
   {
     Scene s = helicalRampScene(1.0);
     out.push_back({s, "climbs: w agrees with the helix's handedness",
-                   "partial sliding on tilted segments and seams between them: pyramid vs "
-                   "cone, glide"});
+                   "partial sliding on tilted segments and across the seams between them: "
+                   "ODE's pyramid vs the cone off the drive direction"});
   }
   {
     Scene s = helicalRampScene(-1.0);

@@ -375,13 +375,14 @@ StepReport World::step(double h) {
   for (std::size_t k = 0; k < s.bodies.size(); ++k) {
     Impl::Body& b = s.bodies[k];
     if (b.kinematic) continue;
+    const Matrix3d r = s.rotation(static_cast<BodyId>(k));
+    const Matrix3d i_world = r * b.inertia_body * r.transpose();
+    // A disabled body keeps its mass in M^-1 (it has no contacts) but does not move.
+    inv_inertia_world[k] = r * b.inv_inertia_body * r.transpose();
     if (b.disabled) {
       v_free.segment<6>(b.dof).setZero();
       continue;
     }
-    const Matrix3d r = s.rotation(static_cast<BodyId>(k));
-    const Matrix3d i_world = r * b.inertia_body * r.transpose();
-    inv_inertia_world[k] = r * b.inv_inertia_body * r.transpose();
     const Vector3d w = toEigen(b.state.angular_velocity);
     v_free.segment<3>(b.dof) =
         toEigen(b.state.linear_velocity) + h * (toEigen(cfg.gravity) + b.force / b.mass);

@@ -266,4 +266,17 @@ Scene linearTroughScene(int count, double rate, double amplitude, double frequen
   return s;
 }
 
+Scene troughHeapScene(int count) {
+  Scene s = linearTroughScene(count, 0, 0.2e-3, 50, 20 * kPi / 180);
+  s.name = "trough_heap";
+  s.fixtures.erase(s.fixtures.begin() + 1);  // no hopper
+  PartSpec& p = s.parts[0];
+  p.spawn_min = {-0.07, -0.04, 0.012};
+  p.spawn_max = {0.23, 0.04, 0.045};
+  s.duration = 3.0;
+  s.outputs.warmup = 0.5;
+  s.outputs.exit_plane = false;
+  return s;
+}
+
 }  // namespace rheofeed::scene

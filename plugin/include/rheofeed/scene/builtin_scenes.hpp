@@ -44,4 +44,9 @@ Scene vibratingTrackScene(double amplitude = 0.2e-3, double frequency = 50, doub
 Scene linearTroughScene(int count = 60, double rate = 20, double amplitude = 0.25e-3,
                         double frequency = 50, double angle = 0.523599);
 
+/// The trough of linearTroughScene without its hopper: `count` boxes dropped at t = 0 as a
+/// heap over its first 0.3 m, vibrating at 50 Hz, 0.2 mm peak, 20 degrees (throw number 0.69,
+/// sliding regime); 3 s with 0.5 s warm-up. The multi-part scene of the error-vs-run-time study.
+Scene troughHeapScene(int count = 40);
+
 }  // namespace rheofeed::scene
