@@ -21,6 +21,7 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
   std::string scene_file, out_dir = "out/" + name;
   double duration = 0, dt = 0;
   std::vector<std::string> methods = {"ode_rheonomic"};
+  bool classical = false;
   CLI::App app{description};
   app.add_option("--scene", scene_file, "scene file (JSON) instead of the built-in scene");
   app.add_option("--duration", duration, "simulated time (s), overrides the scene");
@@ -30,6 +31,9 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
                  "methods to run: ode_rheonomic, ode_full_vibration, reference_rheonomic, "
                  "reference_full_vibration (repeat or list)")
       ->delimiter(',');
+  app.add_flag("--classical", classical,
+               "calibrate a vibration with the classical single-part model (quick estimate) "
+               "instead of a full-vibration sample run");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -61,9 +65,11 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
     for (std::size_t i = 0; i < scene.fixtures.size() && need_calibration; ++i) {
       const FeederLaw& law = scene.fixtures[i].law;
       if (law.kind != FeederLaw::Kind::Vibration || law.has_calibrated_drift) continue;
-      std::fprintf(stderr, "%s: calibrating fixture '%s' by a short full-vibration run...\n",
-                   name.c_str(), scene.fixtures[i].name.c_str());
-      const Calibration c = calibrateBySampling(scene, static_cast<int>(i));
+      std::fprintf(stderr, "%s: calibrating fixture '%s' (%s)...\n", name.c_str(),
+                   scene.fixtures[i].name.c_str(),
+                   classical ? "classical model" : "short full-vibration sample run");
+      const Calibration c = classical ? calibrateClassical(scene, static_cast<int>(i))
+                                      : calibrateBySampling(scene, static_cast<int>(i));
       std::fprintf(stderr, "%s: drift %.5g +- %.2g %s (efficiency %.3f), %.1f s CPU\n",
                    name.c_str(), c.value, c.ci95,
                    law.vibration.torsion_amplitude > 0 ? "rad/s" : "m/s", c.efficiency,

@@ -54,16 +54,31 @@ TEST(RheonomicVsFullVibration, CalibratedDriftConveysACluster) {
   const RunMetrics ode = measureRun(rheo_scene, Method::OdeRheonomic);
   const RunMetrics ref = measureRun(rheo_scene, Method::ReferenceRheonomic);
 
-  std::printf("drift (m/s): full vibration %.5f +- %.5f, calibrated %.5f +- %.5f, ODE rheonomic "
-              "%.5f, reference rheonomic %.5f; CPU (s): full %.2f, ODE rheonomic %.3f\n",
-              full.mean_drift, full.mean_drift_ci95, cal.value, cal.ci95, ode.mean_drift,
-              ref.mean_drift, full.cpu_seconds, ode.cpu_seconds);
+  std::printf(
+      "drift (m/s): full vibration %.5f +- %.5f, calibrated %.5f +- %.5f, ODE rheonomic "
+      "%.5f, reference rheonomic %.5f; CPU (s): full %.2f, ODE rheonomic %.3f\n",
+      full.mean_drift, full.mean_drift_ci95, cal.value, cal.ci95, ode.mean_drift, ref.mean_drift,
+      full.cpu_seconds, ode.cpu_seconds);
   ASSERT_EQ(full.parts, 8);
   EXPECT_NEAR(ode.mean_drift, full.mean_drift, kDriftTolerance * std::abs(full.mean_drift))
       << "full vibration " << full.mean_drift << " m/s, calibrated " << cal.value;
   EXPECT_NEAR(ref.mean_drift, full.mean_drift, kDriftTolerance * std::abs(full.mean_drift));
   // And far cheaper: 100x larger steps.
   EXPECT_LT(ode.cpu_seconds, full.cpu_seconds);
+}
+
+// The quick estimate (classical single-part model) and the sampling calibration (a short ODE
+// full-vibration run) are two independent routes to the same drift on a single flat part.
+TEST(Calibration, ClassicalEstimateMatchesSamplingOnASinglePart) {
+  const Scene scene = vibratingTrackScene(0.2e-3, 50, 20 * M_PI / 180, 1);
+  const Calibration quick = calibrateClassical(scene, 0);
+  CalibrationSettings cs;
+  cs.steps_per_cycle = 400;  // 0.3 % time-discretisation error (tests/validation)
+  const Calibration sampled = calibrateBySampling(scene, 0, cs);
+  // 2 %: the sample's discretisation (0.3 %) plus its shorter averaging window (75 cycles).
+  EXPECT_NEAR(quick.value, sampled.value, 0.02 * sampled.value);
+  EXPECT_EQ(quick.drift.linear.y, 0.0);
+  EXPECT_NEAR(quick.drift.linear.x, quick.value, 1e-15);  // conveying direction +x
 }
 
 }  // namespace

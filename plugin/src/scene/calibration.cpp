@@ -6,6 +6,7 @@
 #include <ctime>
 #include <stdexcept>
 
+#include "rheofeed/scene/classical_model.hpp"
 #include "rheofeed/scene/metrics.hpp"
 
 namespace rheofeed::scene {
@@ -68,6 +69,51 @@ Calibration calibrateBySampling(const Scene& scene, int fixture,
     const double cos_beta = dot(v.direction, scene.outputs.conveying_direction);
     const double peak = v.amplitude * 2 * kPi * v.frequency * cos_beta;
     c.efficiency = peak != 0 ? c.value / peak : 0;
+  }
+  c.cpu_seconds = double(std::clock() - start) / CLOCKS_PER_SEC;
+  return c;
+}
+
+Calibration calibrateClassical(const Scene& scene, int fixture) {
+  scene.validate();
+  if (fixture < 0 || fixture >= static_cast<int>(scene.fixtures.size()) ||
+      scene.fixtures[static_cast<std::size_t>(fixture)].law.kind != FeederLaw::Kind::Vibration) {
+    throw std::invalid_argument("calibrateClassical: fixtures[" + std::to_string(fixture) +
+                                "] is not a vibrating feeder");
+  }
+  const Vibration& v = scene.fixtures[static_cast<std::size_t>(fixture)].law.vibration;
+  const PartSpec& parts = scene.parts[0];
+  const Vec3 point = 0.5 * (parts.spawn_min + parts.spawn_max);
+  const Vec3 up = (-1.0 / norm(scene.gravity)) * scene.gravity;
+  const bool screw = v.torsion_amplitude != 0;
+  Vec3 along = scene.outputs.conveying_direction;
+  Vec3 radial;
+  if (screw) {  // the track runs round the axis at the point's radius
+    radial = tangentialPart(point - v.axis_origin, v.axis_direction);
+    if (norm(radial) == 0) {
+      throw std::invalid_argument("calibrateClassical: the spawn region's centre is on the axis");
+    }
+    along = cross(v.axis_direction, radial);
+    along = (1.0 / norm(along)) * along;
+  }
+  Vec3 normal = tangentialPart(up, along);
+  normal = (1.0 / norm(normal)) * normal;
+  const ClassicalTrack track =
+      classicalTrack(v, point, along, normal, scene.gravity, scene.material.mu);
+  const std::clock_t start = std::clock();
+  const ClassicalDrift drift = classicalDrift(track.params);
+  Calibration c;
+  c.fixture = fixture;
+  c.how = "classical single-part model";
+  const Vec3 velocity = drift.mean_speed * track.conveying_direction;
+  if (screw) {
+    c.value = dot(velocity, along) / norm(radial);
+    c.drift.angular = c.value * v.axis_direction;
+    c.drift.origin = v.axis_origin;
+  } else {
+    c.value = dot(velocity, scene.outputs.conveying_direction);
+    c.drift.linear = c.value * scene.outputs.conveying_direction;
+    c.efficiency = drift.efficiency;
   }
   c.cpu_seconds = double(std::clock() - start) / CLOCKS_PER_SEC;
   return c;

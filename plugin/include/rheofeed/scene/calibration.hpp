@@ -48,6 +48,14 @@ struct Calibration {
 Calibration calibrateBySampling(const Scene& scene, int fixture,
                                 const CalibrationSettings& settings = {});
 
+/// Quick estimate of the drift of fixture `fixture` (which must vibrate) from the classical
+/// single-part model (classical_model.hpp), evaluated at the centre of the spawn region of the
+/// scene's first part family, on a track along Outputs::conveying_direction (translation) or
+/// around the vibration's axis (screw), pressed by gravity. Milliseconds; no uncertainty
+/// (ci95 = 0); it ignores what the single-part model ignores (other parts, walls, rocking).
+/// Throws std::invalid_argument when the model does not apply there (classicalTrack's reasons).
+Calibration calibrateClassical(const Scene& scene, int fixture);
+
 /// A copy of `scene` whose vibrating fixture carries `calibration` as its calibrated drift
 /// ("vibration, calibrated"): rheonomic methods then use it.
 Scene withCalibration(Scene scene, const Calibration& calibration);
