@@ -10,7 +10,8 @@
 //  4. writes study.csv, study.md (table + speed-up at equal error) and study.png (log-log error
 //     vs CPU time, one curve per method) into --out.
 //
-//   feeder_study [--scene track|trough|hopper|FILE.json] [--out out/study] [--seeds 3] [--quick]
+//   feeder_study [--scene track|trough|heap|hopper|FILE.json] [--out out/study] [--seeds 3]
+//   [--quick]
 //                [--rtf-parts 500]
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -59,8 +60,8 @@ int main(int argc, char** argv) {
   int rtf_parts = 0;
   CLI::App app{"rheofeed error-vs-run-time study: rheonomic vs full vibration"};
   app.add_option("--scene", scene_arg,
-                 "built-in scene (track: one part; trough: a heap of 40 parts; hopper: the "
-                 "linear_feeder demo) or a scene file (.json)");
+                 "built-in scene (track: one part; trough: 40 parts in a layer; heap: 40 "
+                 "parts in a heap; hopper: the linear_feeder demo) or a scene file (.json)");
   app.add_option("--out", out_dir, "output folder");
   app.add_option("--seeds", seeds, "seeds of the converged reference")->check(CLI::Range(1, 50));
   app.add_flag("--quick", quick, "coarser sweeps and a shorter reference (for a smoke run)");
@@ -71,7 +72,8 @@ int main(int argc, char** argv) {
 
   try {
     Scene scene = scene_arg == "track"    ? vibratingTrackScene()
-                  : scene_arg == "trough" ? troughHeapScene()
+                  : scene_arg == "trough" ? troughScene()
+                  : scene_arg == "heap"   ? troughScene(40, true)
                   : scene_arg == "hopper" ? linearTroughScene()
                                           : loadScene(scene_arg);
     scene.validate();

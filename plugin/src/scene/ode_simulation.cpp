@@ -29,6 +29,7 @@ class OdeSimulation final : public PartSimulation {
     dWorldSetCFM(world_, scene.solver.cfm);
     dWorldSetQuickStepNumIterations(world_, scene.solver.iterations);
     dWorldSetContactMaxCorrectingVel(world_, scene.solver.max_correcting_velocity);
+    dWorldSetContactSurfaceLayer(world_, scene.solver.surface_layer);
     space_ = dHashSpaceCreate(nullptr);
     feeders_ = std::make_unique<FeederSet>();
 

@@ -25,6 +25,7 @@ class ReferenceSimulation final : public PartSimulation {
     s.solver.tolerance = scene.solver.tolerance;
     s.solver.coulomb_outer_iterations = scene.solver.coulomb_iterations;
     s.max_correcting_velocity = scene.solver.max_correcting_velocity;
+    s.surface_layer = scene.solver.surface_layer;
     world_ = std::make_unique<reference::World>(s);
 
     for (const Fixture& f : scene.fixtures) {

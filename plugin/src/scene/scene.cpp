@@ -145,6 +145,7 @@ void Scene::validate() const {
   if (!(solver.erp >= 0 && solver.erp <= 1)) bad("solver.erp", solver.erp, "must be in [0, 1]");
   nonNegative("solver.cfm", solver.cfm);
   positive("solver.max_correcting_velocity", solver.max_correcting_velocity);
+  nonNegative("solver.surface_layer", solver.surface_layer);
   finite("removal_height", removal_height);
   if (solver.coulomb_iterations < 0) {
     bad("solver.coulomb_iterations", solver.coulomb_iterations, "must be >= 0");

@@ -624,6 +624,7 @@ Scene readScene(const json& root) {
     m.opt("apgd", x.apgd);
     m.opt("coulomb_iterations", x.coulomb_iterations, 0);
     m.opt("max_correcting_velocity", x.max_correcting_velocity, Range::Positive);
+    m.opt("surface_layer", x.surface_layer, Range::NonNegative);
     m.finish();
   }
   o.opt("duration", s.duration, Range::Positive);
@@ -909,7 +910,8 @@ std::string toJson(const Scene& scene) {
                    {"tolerance", x.tolerance},
                    {"apgd", x.apgd},
                    {"coulomb_iterations", x.coulomb_iterations},
-                   {"max_correcting_velocity", x.max_correcting_velocity}};
+                   {"max_correcting_velocity", x.max_correcting_velocity},
+                   {"surface_layer", x.surface_layer}};
   const Outputs& o = scene.outputs;
   const Outputs defaults;
   ojson oj{{"conveying_direction", toJson(o.conveying_direction)}};

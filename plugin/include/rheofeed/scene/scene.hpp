@@ -141,6 +141,12 @@ struct SolverSettings {
   /// dWorldSetContactMaxCorrectingVel, mirrored by the reference. Without it ERP depth / h
   /// becomes a launch speed at small h (0.2 x 5 mm / 0.1 ms = 10 m/s).
   double max_correcting_velocity = 0.5;
+  /// Penetration depth (m, >= 0) left uncorrected by ERP, ODE's
+  /// dWorldSetContactSurfaceLayer, mirrored by the reference. Without it every landing on a
+  /// vibrating surface is followed by an ERP push that can lock a part into a chattering
+  /// orbit of its own (parts at 0.26x or 1.3x the drift of their neighbours, depending on ERP;
+  /// 1e-4 m removes it in the trough scenes of builtin_scenes.hpp).
+  double surface_layer = 0.0;
 };
 
 /// The four methods.
