@@ -14,7 +14,7 @@
 
 int main(int argc, char** argv) {
   rheofeed::scene::Scene scene = rheofeed::scene::linearTroughScene(/*count=*/120, /*rate=*/20);
-  scene.duration = 10.0;
+  scene.duration = 30.0;  // parts need about 19 s from the hopper to the exit
   return rheofeed::demo::runDemo(argc, argv, "linear_feeder",
                                  "rheofeed linear vibratory feeder: hopper + trough", scene);
 }

@@ -68,7 +68,7 @@ Scene turntable() {
   }
   p.density = 1200;
   p.spawn_min = {0.03, -0.25, 0.03};  // clear of the fence (x = 0, y = 0.05..0.35)
-  p.spawn_max = {0.25, 0.10, 0.08};
+  p.spawn_max = {0.25, 0.10, 0.20};
   p.random_orientation = true;
   p.count = 40;
   s.parts.push_back(p);

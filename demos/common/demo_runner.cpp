@@ -17,7 +17,7 @@ namespace rheofeed::demo {
 using namespace rheofeed::scene;
 
 int runDemo(int argc, char** argv, const std::string& name, const std::string& description,
-            Scene scene) {
+            Scene scene, const DemoOptions& options) {
   std::string scene_file, out_dir = "out/" + name;
   double duration = 0, dt = 0;
   std::vector<std::string> methods = {"ode_rheonomic"};
@@ -38,6 +38,9 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
 
   try {
     if (!scene_file.empty()) scene = loadScene(scene_file);
+    if (dt != 0 && (!(dt > 0) || !std::isfinite(dt))) {
+      throw std::invalid_argument("--dt = " + std::to_string(dt) + ": must be > 0 (s)");
+    }
     if (duration != 0) {
       if (!(duration > 0) || !std::isfinite(duration)) {
         throw std::invalid_argument("--duration = " + std::to_string(duration) + ": must be > 0");
@@ -70,22 +73,29 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
                    classical ? "classical model" : "short full-vibration sample run");
       const Calibration c = classical ? calibrateClassical(scene, static_cast<int>(i))
                                       : calibrateBySampling(scene, static_cast<int>(i));
-      std::fprintf(stderr, "%s: drift %.5g +- %.2g %s (efficiency %.3f), %.1f s CPU\n",
-                   name.c_str(), c.value, c.ci95,
-                   law.vibration.torsion_amplitude > 0 ? "rad/s" : "m/s", c.efficiency,
-                   c.cpu_seconds);
+      if (law.vibration.torsion_amplitude > 0) {
+        std::fprintf(stderr, "%s: angular drift %.5g +- %.2g rad/s, %.1f s CPU\n", name.c_str(),
+                     c.value, c.ci95, c.cpu_seconds);
+      } else {
+        std::fprintf(stderr, "%s: drift %.5g +- %.2g m/s (efficiency %.3f), %.1f s CPU\n",
+                     name.c_str(), c.value, c.ci95, c.efficiency, c.cpu_seconds);
+      }
       scene = withCalibration(scene, c);
     }
 
+    const std::string unit = scene.outputs.angular_drift ? "rad/s" : "m/s";
     std::printf(
-        "| method | h (s) | parts | mean drift (m/s) | 95 %% CI | vertical disp. (m) | "
+        "| method | h (s) | parts | mean drift (%s) | 95 %% CI | vertical disp. (m) | "
         "throughput (parts/s) | CPU (s) | real-time factor "
-        "|\n|---|---|---|---|---|---|---|---|---|\n");
+        "|\n|---|---|---|---|---|---|---|---|---|\n",
+        unit.c_str());
     std::vector<std::pair<std::string, std::string>> blocks;
     for (Method m : chosen) {
       Scene s = scene;
       if (!isFullVibration(m)) {
-        s.solver.time_step = dt > 0 ? dt : (scene.hasVibration() ? 0.01 : scene.solver.time_step);
+        s.solver.time_step =
+            dt > 0 ? dt
+                   : (scene.hasVibration() ? options.rheonomic_time_step : scene.solver.time_step);
         s.outputs.sample_interval = std::max(s.outputs.sample_interval, s.solver.time_step);
       } else {
         s.solver.time_step = full_step;
@@ -100,14 +110,25 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
     if (blocks.size() > 1) {  // one plot with every method's drift
       std::string gp =
           "set datafile separator ','\nset grid\nset key bottom right\n"
-          "set xlabel 'time (s)'\nset ylabel 'mean drift velocity (m/s)'\n"
-          "set title '" +
-          scene.name + ": methods compared'\nplot ";
+          "set xlabel 'time (s)'\nset ylabel 'mean drift (" +
+          unit + ")'\nset title '" + scene.name + ": methods compared'\nplot ";
       for (std::size_t k = 0; k < blocks.size(); ++k) {
         gp += (k ? ", " : "") + std::string("$") + blocks[k].first +
               " using 1:3 with lines lw 2 title '" + blocks[k].first + "'";
       }
       plotPng(gp, blocks, (std::filesystem::path(out_dir) / "methods.png").string());
+    }
+    if (options.plot_height && !blocks.empty()) {  // mean height of the parts, every method
+      std::string gp =
+          "set datafile separator ','\nset grid\nset key bottom right\n"
+          "set xlabel 'time (s)'\nset ylabel 'mean height of the parts (mm)'\n"
+          "set title '" +
+          scene.name + ": mean height of the parts'\nplot ";
+      for (std::size_t k = 0; k < blocks.size(); ++k) {
+        gp += (k ? ", " : "") + std::string("$") + blocks[k].first +
+              " using 1:(1000 * $5) with lines lw 2 title '" + blocks[k].first + "'";
+      }
+      plotPng(gp, blocks, (std::filesystem::path(out_dir) / "mean_height.png").string());
     }
     std::printf("\noutputs in %s/\n", out_dir.c_str());
   } catch (const std::exception& e) {

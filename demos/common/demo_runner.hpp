@@ -10,10 +10,19 @@
 
 namespace rheofeed::demo {
 
-/// Parses the demo's command line (--scene, --duration, --dt, --out, --method, --full, ...),
-/// runs the scene and prints a summary. Returns the process exit code (0 on success, 2 on bad
-/// input with the message on stderr).
+/// What a demo may change in the runner.
+struct DemoOptions {
+  /// Time step of the rheonomic runs of a scene with a vibrating feeder when --dt is not given
+  /// (s); scenes without vibration use their own solver.time_step.
+  double rheonomic_time_step = 0.01;
+  /// Also plot the parts' mean height against time for every method (mean_height.png).
+  bool plot_height = false;
+};
+
+/// Parses the demo's command line (--scene, --duration, --dt, --out, --method, --classical),
+/// runs the scene and prints a summary. Returns the process exit code: 0 on success, 2 on bad
+/// input (message on stderr), CLI11's own codes for a malformed command line.
 int runDemo(int argc, char** argv, const std::string& name, const std::string& description,
-            scene::Scene builtin);
+            scene::Scene builtin, const DemoOptions& options = {});
 
 }  // namespace rheofeed::demo

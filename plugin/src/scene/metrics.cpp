@@ -83,6 +83,7 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
   m.scene = scene.name;
   m.method = method;
   m.time_step = h;
+  m.angular = out.angular_drift;
   std::vector<Track> tracks;
   int exited_total = 0, exited_after_warmup = 0;
 
@@ -224,10 +225,11 @@ std::string summaryJson(const RunMetrics& r) {
   char b[768];
   std::snprintf(b, sizeof b,
                 "{\"scene\": \"%s\", \"method\": \"%s\", \"time_step_s\": %.8g, \"parts\": %d, "
-                "\"mean_drift_mps\": %.8g, \"mean_drift_ci95_mps\": %.8g, "
+                "\"drift_unit\": \"%s\", \"mean_drift\": %.8g, \"mean_drift_ci95\": %.8g, "
                 "\"vertical_displacement_m\": %.8g, \"throughput_parts_per_s\": %.8g, "
                 "\"cpu_seconds\": %.6g, \"simulated_seconds\": %.6g, \"real_time_factor\": %.6g}",
-                r.scene.c_str(), toString(r.method), r.time_step, r.parts, r.mean_drift,
+                r.scene.c_str(), toString(r.method), r.time_step, r.parts,
+                r.angular ? "rad/s" : "m/s", r.mean_drift,
                 r.mean_drift_ci95, r.vertical_displacement, r.throughput, r.cpu_seconds,
                 r.simulated_seconds, r.real_time_factor);
   return b;
@@ -246,7 +248,9 @@ std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::strin
   std::ostringstream gp;
   gp << "set datafile separator ','\n"
      << "set key bottom right\nset grid\n"
-     << "set xlabel 'time (s)'\nset ylabel 'mean drift velocity (m/s)'\n"
+     << "set xlabel 'time (s)'\nset ylabel '"
+     << (run.angular ? "mean angular drift about the axis (rad/s)" : "mean drift velocity (m/s)")
+     << "'\n"
      << "set title '" << run.scene << ": " << toString(run.method) << ", h = " << run.time_step
      << " s, " << run.parts << " parts'\n"
      << "plot $data using 1:($3-$4):($3+$4) with filledcurves fc rgb '#c0d0f0' title '95 % CI', "

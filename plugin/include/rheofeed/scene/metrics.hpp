@@ -35,6 +35,7 @@ struct RunMetrics {
   std::string scene;
   Method method = Method::OdeRheonomic;
   double time_step = 0;  ///< (s)
+  bool angular = false;  ///< the drift is an angular velocity (rad/s) instead of m/s
   std::vector<DriftSample> series;
   /// Mean drift (m/s along d, or rad/s about the axis) over [warmup, end]: total displacement of
   /// the measured parts divided by time, averaged over parts.
