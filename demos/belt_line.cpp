@@ -11,26 +11,10 @@
 // demos/belt_conveyor.cpp is the same kind of line written directly against the plugin API.
 //
 //   belt_line [--scene FILE.json] [--duration s] [--dt s] [--out folder] [--method ...]
-#include <cstdio>
-#include <exception>
-#include <filesystem>
-
 #include "common/demo_runner.hpp"
-#include "rheofeed/scene/scene_io.hpp"
-
-#ifndef RHEOFEED_DEMO_SCENES_DIR
-#error "RHEOFEED_DEMO_SCENES_DIR must name the folder of the built-in scene files"
-#endif
 
 int main(int argc, char** argv) {
-  rheofeed::scene::Scene scene;
-  try {
-    scene = rheofeed::scene::loadScene(std::filesystem::path(RHEOFEED_DEMO_SCENES_DIR) /
-                                       "belt_conveyor.json");
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "belt_line: built-in scene: %s\n", e.what());
-    return 2;
-  }
-  return rheofeed::demo::runDemo(argc, argv, "belt_line",
-                                 "rheofeed belt-conveyor line: hopper, belt, exit plane", scene);
+  return rheofeed::demo::runSceneFileDemo(argc, argv, "belt_line",
+                                          "rheofeed belt-conveyor line: hopper, belt, exit plane",
+                                          "belt_conveyor.json");
 }

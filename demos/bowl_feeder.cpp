@@ -22,30 +22,14 @@
 //
 //   bowl_feeder [--scene FILE.json] [--duration s] [--dt s] [--out folder]
 //               [--method ode_rheonomic,ode_full_vibration,...]
-#include <cstdio>
-#include <exception>
-#include <filesystem>
-
 #include "common/demo_runner.hpp"
-#include "rheofeed/scene/scene_io.hpp"
-
-#ifndef RHEOFEED_DEMO_SCENES_DIR
-#error "RHEOFEED_DEMO_SCENES_DIR must name the folder of the built-in scene files"
-#endif
 
 int main(int argc, char** argv) {
-  rheofeed::scene::Scene scene;
-  try {
-    scene = rheofeed::scene::loadScene(std::filesystem::path(RHEOFEED_DEMO_SCENES_DIR) /
-                                       "bowl_feeder.json");
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bowl_feeder: built-in scene: %s\n", e.what());
-    return 2;
-  }
   rheofeed::demo::DemoOptions options;
   options.rheonomic_time_step = 0.005;  // s: see the header comment
   options.plot_height = true;
-  return rheofeed::demo::runDemo(
+  return rheofeed::demo::runSceneFileDemo(
       argc, argv, "bowl_feeder",
-      "rheofeed vibratory bowl feeder: helical ramp, CAD meshes (assimp), M6 nuts", scene, options);
+      "rheofeed vibratory bowl feeder: helical ramp, CAD meshes (assimp), M6 nuts",
+      "bowl_feeder.json", options);
 }

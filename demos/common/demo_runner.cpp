@@ -138,4 +138,16 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
   return 0;
 }
 
+int runSceneFileDemo(int argc, char** argv, const std::string& name, const std::string& description,
+                     const std::string& file_name, const DemoOptions& options) {
+  Scene scene;
+  try {
+    scene = loadScene(std::filesystem::path(RHEOFEED_DEMO_SCENES_DIR) / file_name);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: built-in scene: %s\n", name.c_str(), e.what());
+    return 2;
+  }
+  return runDemo(argc, argv, name, description, scene, options);
+}
+
 }  // namespace rheofeed::demo

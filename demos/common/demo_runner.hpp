@@ -25,4 +25,9 @@ struct DemoOptions {
 int runDemo(int argc, char** argv, const std::string& name, const std::string& description,
             scene::Scene builtin, const DemoOptions& options = {});
 
+/// runDemo with the scene file `file_name` of demos/scenes/ as the built-in scene (a file that
+/// cannot be loaded exits with 2 and the loader's message).
+int runSceneFileDemo(int argc, char** argv, const std::string& name, const std::string& description,
+                     const std::string& file_name, const DemoOptions& options = {});
+
 }  // namespace rheofeed::demo
