@@ -229,9 +229,9 @@ std::string summaryJson(const RunMetrics& r) {
                 "\"vertical_displacement_m\": %.8g, \"throughput_parts_per_s\": %.8g, "
                 "\"cpu_seconds\": %.6g, \"simulated_seconds\": %.6g, \"real_time_factor\": %.6g}",
                 r.scene.c_str(), toString(r.method), r.time_step, r.parts,
-                r.angular ? "rad/s" : "m/s", r.mean_drift,
-                r.mean_drift_ci95, r.vertical_displacement, r.throughput, r.cpu_seconds,
-                r.simulated_seconds, r.real_time_factor);
+                r.angular ? "rad/s" : "m/s", r.mean_drift, r.mean_drift_ci95,
+                r.vertical_displacement, r.throughput, r.cpu_seconds, r.simulated_seconds,
+                r.real_time_factor);
   return b;
 }
 
