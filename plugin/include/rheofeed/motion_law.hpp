@@ -123,8 +123,11 @@ class MotionLaw {
 
   Kind kind() const { return kind_; }
   Frame frame() const { return frame_; }
-  /// The constant twist (Twist kind) or the belt as {direction * speed, 0, 0} (Belt kind).
+  /// The constant twist (Twist kind); for the Belt kind, `linear` is the unit belt direction
+  /// and beltSpeed() its speed.
   const Twist& constantTwist() const { return twist_; }
+  /// Belt speed (m/s; Belt kind, else 0).
+  double beltSpeed() const { return kind_ == Kind::Belt ? belt_speed_ : 0.0; }
   const TimeProfile& profile() const { return profile_; }
   /// True if the law's values can change with time (a profile, a twist function, a time-varying
   /// field). Constant laws are evaluated once and cached.
