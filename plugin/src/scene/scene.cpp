@@ -99,6 +99,18 @@ const char* toString(Shape::Kind kind) {
   return "unknown";
 }
 
+int partSizeCount(Shape::Kind kind) {
+  switch (kind) {
+    case Shape::Kind::Box:
+      return 3;
+    case Shape::Kind::Cylinder:
+    case Shape::Kind::Capsule:
+      return 2;
+    default:
+      return 1;
+  }
+}
+
 const char* toString(Method method) {
   switch (method) {
     case Method::OdeRheonomic:
@@ -209,9 +221,7 @@ void Scene::validate() const {
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const PartSpec& p = parts[i];
     const std::string path = "parts[" + std::to_string(i) + "]";
-    const int dims = p.shape == Shape::Kind::Box                                             ? 3
-                     : (p.shape == Shape::Kind::Cylinder || p.shape == Shape::Kind::Capsule) ? 2
-                                                                                             : 1;
+    const int dims = partSizeCount(p.shape);
     if (p.shape == Shape::Kind::Plane)
       throw std::invalid_argument(path + ".shape: a part cannot be a plane");
     if (p.shape == Shape::Kind::Mesh && p.mesh.empty())

@@ -102,6 +102,10 @@ struct Distribution {
   double max = 1e300;
 };
 
+/// How many size distributions a part of this shape has: box 3 (x, y, z edges), cylinder and
+/// capsule 2 (radius, length), sphere and mesh 1 (radius; mesh scale).
+int partSizeCount(Shape::Kind kind);
+
 /// A family of parts.
 struct PartSpec {
   std::string name = "parts";
