@@ -47,7 +47,8 @@ class ContactCollider {
     /// Options::record_contacts.
     bool feedback = false;
     /// Surface used when no SurfaceCallback is set: Approx1 friction with mu = 0.5.
-    dSurfaceParameters default_surface = {dContactApprox1, 0.5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    dSurfaceParameters default_surface = {
+        dContactApprox1, 0.5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
   };
 
   /// `world` receives the joints; `feeders` must outlive the collider. Throws
