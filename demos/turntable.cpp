@@ -40,10 +40,8 @@ Scene turntable() {
     Fixture::Geom b;
     b.shape.kind = Shape::Kind::Box;
     b.shape.size = {0.02, 2 * (kRadius + 0.01) * std::tan(kPi / 36) + 0.005, 0.06};
-    b.pose.position = {(kRadius + 0.02) * std::cos(a), (kRadius + 0.02) * std::sin(a), 0.02};
-    const double c = std::cos(a), sn = std::sin(a);
-    const double r[9] = {c, -sn, 0, sn, c, 0, 0, 0, 1};
-    for (int k = 0; k < 9; ++k) b.pose.rotation[k] = r[k];
+    b.pose = Pose::axisAngle(
+        {0, 0, 1}, a, {(kRadius + 0.02) * std::cos(a), (kRadius + 0.02) * std::sin(a), 0.02});
     rim.geoms.push_back(b);
   }
   s.fixtures.push_back(rim);

@@ -69,6 +69,19 @@ struct Pose {
   }
   /// R a + position: a point from the body frame to the world frame (m).
   Vec3 transform(const Vec3& a) const { return rotate(a) + position; }
+
+  /// The rotation by `angle` (rad, right hand) about the unit axis `k` (Rodrigues), placed at
+  /// `position` (m).
+  static Pose axisAngle(const Vec3& k, double angle, const Vec3& position = {}) {
+    const double c = std::cos(angle), s = std::sin(angle), v = 1 - c;
+    Pose p;
+    const double r[9] = {c + k.x * k.x * v,       k.x * k.y * v - k.z * s, k.x * k.z * v + k.y * s,
+                         k.y * k.x * v + k.z * s, c + k.y * k.y * v,       k.y * k.z * v - k.x * s,
+                         k.z * k.x * v - k.y * s, k.z * k.y * v + k.x * s, c + k.z * k.z * v};
+    for (int i = 0; i < 9; ++i) p.rotation[i] = r[i];
+    p.position = position;
+    return p;
+  }
 };
 
 }  // namespace rheofeed

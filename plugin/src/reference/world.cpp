@@ -292,7 +292,7 @@ BodyId World::addKinematicBody(MotionOfTime motion) {
   const Pose p = b.motion(impl_->time);
   if (!isFinite(p.position)) refuse("addKinematicBody: motion(t) position is not finite");
   b.state.position = p.position;
-  b.state.orientation = toQuat(Eigen::Quaterniond(rotationOf(p)).normalized());
+  b.state.orientation = toQuat(p);
   impl_->bodies.push_back(std::move(b));
   return static_cast<BodyId>(impl_->bodies.size() - 1);
 }
@@ -329,6 +329,19 @@ void World::addForce(BodyId body, const Vec3& force, const Vec3& torque) {
   impl_->bodies[body].torque += toEigen(torque);
 }
 
+Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h) {
+  const Eigen::AngleAxisd rel(rotationOf(p1) * rotationOf(p0).transpose());
+  return toVec3(rel.axis() * (rel.angle() / h));
+}
+
+Quat toQuat(const Pose& pose) {
+  return toQuat(Eigen::Quaterniond(rotationOf(pose)).normalized());
+}
+
+Pose toPose(const Quat& q, const Vec3& position) {
+  return poseOf(toEigen(position), toEigen(q).normalized().toRotationMatrix());
+}
+
 StepReport World::step(double h) {
   Impl& s = *impl_;
   if (!(h > 0) || !std::isfinite(h)) {
@@ -353,12 +366,10 @@ StepReport World::step(double h) {
           << ").position = (" << x.x << ", " << x.y << ", " << x.z << ") is not finite";
       refuse(out.str());
     }
-    const Matrix3d r0 = rotationOf(p0), r1 = rotationOf(p1);
-    const Eigen::AngleAxisd rel(r1 * r0.transpose());
     b.state.position = p0.position;
-    b.state.orientation = toQuat(Eigen::Quaterniond(r0).normalized());
+    b.state.orientation = toQuat(p0);
     b.state.linear_velocity = (1.0 / h) * (p1.position - p0.position);
-    b.state.angular_velocity = toVec3(rel.axis() * (rel.angle() / h));
+    b.state.angular_velocity = secantAngularVelocity(p0, p1, h);
     next_pose[k] = p1;
   }
 
@@ -531,7 +542,7 @@ StepReport World::step(double h) {
     Impl::Body& b = s.bodies[k];
     if (b.kinematic) {
       b.state.position = next_pose[k].position;
-      b.state.orientation = toQuat(Eigen::Quaterniond(rotationOf(next_pose[k])).normalized());
+      b.state.orientation = toQuat(next_pose[k]);
       continue;
     }
     if (b.disabled) continue;

@@ -8,18 +8,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Rotation about unit axis k by angle a (row-major, body to world).
-Pose rotated(const Vec3& k, double a, const Vec3& position) {
-  const double c = std::cos(a), s = std::sin(a), v = 1 - c;
-  Pose p;
-  const double r[9] = {c + k.x * k.x * v,       k.x * k.y * v - k.z * s, k.x * k.z * v + k.y * s,
-                       k.y * k.x * v + k.z * s, c + k.y * k.y * v,       k.y * k.z * v - k.x * s,
-                       k.z * k.x * v - k.y * s, k.z * k.y * v + k.x * s, c + k.z * k.z * v};
-  for (int i = 0; i < 9; ++i) p.rotation[i] = r[i];
-  p.position = position;
-  return p;
-}
-
 Fixture boxFixture(const std::string& name, const Vec3& size, const Pose& pose) {
   Fixture f;
   f.name = name;
@@ -65,8 +53,8 @@ Scene inclineBeltScene(double angle, double speed) {
   s.name = "incline_belt";
   // Rotating about -y by `angle` lifts +x. The belt's top surface passes through the origin.
   const Vec3 axis{0, -1, 0};
-  const Pose tilt = rotated(axis, angle, {0, 0, 0});
-  s.fixtures[0].geoms[0].pose = rotated(axis, angle, tilt.rotate({0, 0, -0.05}));
+  const Pose tilt = Pose::axisAngle(axis, angle, {0, 0, 0});
+  s.fixtures[0].geoms[0].pose = Pose::axisAngle(axis, angle, tilt.rotate({0, 0, -0.05}));
   s.fixtures[0].law.belt_direction = {std::cos(angle), 0, std::sin(angle)};
   PartSpec& p = s.parts[0];
   p.spawn_min = p.spawn_max = tilt.rotate({-0.5, 0, 0.026});
@@ -109,10 +97,10 @@ Scene helicalRampScene(double omega) {
     const double z = kPitch * phi / (2 * kPi);
     // Segment frame: x along the tangent (rising), y radial-in, z up; tilt by `slope` about
     // the radial axis, then turn to phi.
-    const Pose heading = rotated({0, 0, 1}, phi + kPi / 2, {0, 0, 0});
+    const Pose heading = Pose::axisAngle({0, 0, 1}, phi + kPi / 2, {0, 0, 0});
     // Turning the tangent about the outward radial axis r by +slope lifts it (r x t = +z).
     const Vec3 radial = heading.rotate({0, -1, 0});
-    const Pose tilt = rotated(radial, slope, {0, 0, 0});
+    const Pose tilt = Pose::axisAngle(radial, slope, {0, 0, 0});
     Pose p;
     // Compose tilt * heading.
     for (int r = 0; r < 3; ++r) {

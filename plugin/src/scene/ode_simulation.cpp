@@ -4,7 +4,6 @@
 // body is put on its law at t and given the secant velocity to its pose at t + h).
 #include <ode/ode.h>
 
-#include <Eigen/Geometry>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -13,6 +12,7 @@
 #include "geom_factory.hpp"
 #include "rheofeed/contact_collider.hpp"
 #include "rheofeed/feeder_set.hpp"
+#include "rheofeed/reference/world.hpp"
 #include "simulation_internal.hpp"
 
 namespace rheofeed::scene {
@@ -129,7 +129,7 @@ class OdeSimulation final : public PartSimulation {
     dBodySetRotation(body, r);
     const Vec3 lin = (1.0 / h) * (p1.position - p0.position);
     dBodySetLinearVel(body, lin.x, lin.y, lin.z);
-    const Vec3 ang = secantAngularVelocity(p0, p1, h);
+    const Vec3 ang = reference::secantAngularVelocity(p0, p1, h);
     dBodySetAngularVel(body, ang.x, ang.y, ang.z);
   }
 

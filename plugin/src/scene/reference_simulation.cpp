@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // A scene run in the reference world (rheofeed::reference::World, cone complementarity).
+#include <algorithm>
 #include <memory>
 #include <unordered_set>
 
@@ -59,17 +60,8 @@ class ReferenceSimulation final : public PartSimulation {
     s.position = b.position;
     s.velocity = b.linear_velocity;
     s.angular_velocity = b.angular_velocity;
-    const reference::Quat& q = b.orientation;
-    double* r = s.rotation;
-    r[0] = 1 - 2 * (q.y * q.y + q.z * q.z);
-    r[1] = 2 * (q.x * q.y - q.z * q.w);
-    r[2] = 2 * (q.x * q.z + q.y * q.w);
-    r[3] = 2 * (q.x * q.y + q.z * q.w);
-    r[4] = 1 - 2 * (q.x * q.x + q.z * q.z);
-    r[5] = 2 * (q.y * q.z - q.x * q.w);
-    r[6] = 2 * (q.x * q.z - q.y * q.w);
-    r[7] = 2 * (q.y * q.z + q.x * q.w);
-    r[8] = 1 - 2 * (q.x * q.x + q.y * q.y);
+    const Pose pose = reference::toPose(b.orientation);
+    std::copy(pose.rotation, pose.rotation + 9, s.rotation);
     return s;
   }
 
@@ -78,30 +70,10 @@ class ReferenceSimulation final : public PartSimulation {
     reference::BodyState state;
     state.position = p.pose.position;
     state.linear_velocity = p.velocity;
-    state.orientation = quatOf(p.pose);
+    state.orientation = reference::toQuat(p.pose);
     const BodyId body = world_->addBody(p.mass, p.inertia, state);
     world_->attachGeom(createGeom(world_->space(), p.shape, meshes_), body);
     parts_.push_back(body);
-  }
-
-  static reference::Quat quatOf(const Pose& pose) {
-    const double* m = pose.rotation;
-    reference::Quat q;
-    const double tr = m[0] + m[4] + m[8];
-    if (tr > 0) {
-      const double s = 0.5 / std::sqrt(tr + 1.0);
-      q = {0.25 / s, (m[7] - m[5]) * s, (m[2] - m[6]) * s, (m[3] - m[1]) * s};
-    } else if (m[0] > m[4] && m[0] > m[8]) {
-      const double s = 2.0 * std::sqrt(1.0 + m[0] - m[4] - m[8]);
-      q = {(m[7] - m[5]) / s, 0.25 * s, (m[1] + m[3]) / s, (m[2] + m[6]) / s};
-    } else if (m[4] > m[8]) {
-      const double s = 2.0 * std::sqrt(1.0 + m[4] - m[0] - m[8]);
-      q = {(m[2] - m[6]) / s, (m[1] + m[3]) / s, 0.25 * s, (m[5] + m[7]) / s};
-    } else {
-      const double s = 2.0 * std::sqrt(1.0 + m[8] - m[0] - m[4]);
-      q = {(m[3] - m[1]) / s, (m[2] + m[6]) / s, (m[5] + m[7]) / s, 0.25 * s};
-    }
-    return q;
   }
 
   ContactTotals fixtureImpulses(double) const override {

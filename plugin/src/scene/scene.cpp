@@ -137,14 +137,8 @@ Pose Vibration::displacement(double t) const {
     pose.position = shift;
     return pose;
   }
-  // Rotation by theta about axis_direction (Rodrigues), about the point axis_origin.
-  const double theta = torsion_amplitude * s, c = std::cos(theta), sn = std::sin(theta);
-  const Vec3& k = axis_direction;
-  const double kx = k.x, ky = k.y, kz = k.z, v = 1 - c;
-  const double r[9] = {c + kx * kx * v,       kx * ky * v - kz * sn, kx * kz * v + ky * sn,
-                       ky * kx * v + kz * sn, c + ky * ky * v,       ky * kz * v - kx * sn,
-                       kz * kx * v - ky * sn, kz * ky * v + kx * sn, c + kz * kz * v};
-  for (int i = 0; i < 9; ++i) pose.rotation[i] = r[i];
+  // Rotation by theta about axis_direction, about the point axis_origin.
+  pose = Pose::axisAngle(axis_direction, torsion_amplitude * s);
   pose.position = axis_origin - pose.rotate(axis_origin) + shift;
   return pose;
 }

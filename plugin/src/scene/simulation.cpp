@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "rheofeed/scene/simulation.hpp"
 
-#include <Eigen/Geometry>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -9,19 +8,6 @@
 #include "simulation_internal.hpp"
 
 namespace rheofeed::scene {
-
-Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h) {
-  Eigen::Matrix3d r0, r1;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      r0(i, j) = p0.rotation[3 * i + j];
-      r1(i, j) = p1.rotation[3 * i + j];
-    }
-  }
-  const Eigen::AngleAxisd rel(r1 * r0.transpose());
-  const Eigen::Vector3d w = rel.axis() * (rel.angle() / h);
-  return {w.x(), w.y(), w.z()};
-}
 
 void checkPart(int index, const Vec3& x, Method method, double time) {
   constexpr double kSceneRadius = 1e4;  // m: nothing in a feeder scene gets this far

@@ -64,7 +64,4 @@ std::unique_ptr<Simulation> makeReferenceSimulation(const Scene& scene, Method m
 /// 1e4 m: an unstable step, caught before ODE's collision asserts on it.
 void checkPart(int index, const Vec3& x, Method method, double time);
 
-/// Angular velocity (rad/s, world) that turns pose p0's rotation into p1's in h seconds.
-Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h);
-
 }  // namespace rheofeed::scene

@@ -54,6 +54,13 @@ struct Quat {
   double w = 1, x = 0, y = 0, z = 0;
 };
 
+/// Angular velocity (rad/s, world) that turns p0's rotation into p1's in h seconds (the
+/// secant of a prescribed rotation, as given to kinematic bodies).
+Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h);
+/// The rotation of a pose as a unit quaternion, and back (row-major matrix, body to world).
+Quat toQuat(const Pose& pose);
+Pose toPose(const Quat& q, const Vec3& position = {});
+
 /// A prescribed motion: pose of the body at time t (s).
 using MotionOfTime = std::function<Pose(double t)>;
 
