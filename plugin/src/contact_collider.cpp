@@ -36,9 +36,9 @@ void ContactCollider::clearJoints() {
   feedback_used_ = 0;
 }
 
-void ContactCollider::collide(dSpaceID space, double time) {
+void ContactCollider::collide(dSpaceID space, double time, double step) {
   clearJoints();
-  feeders_.beginStep(time);
+  feeders_.beginStep(time, step);
   collideWithin(space);
 }
 

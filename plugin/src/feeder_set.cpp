@@ -253,7 +253,8 @@ int FeederSet::size() const {
   return static_cast<int>(impl_->feeders.size());
 }
 
-void FeederSet::beginStep(double time) {
+void FeederSet::beginStep(double time, double step) {
+  (void)step;  // TODO(issue 7)
   if (!std::isfinite(time)) {
     std::ostringstream out;
     out << "rheofeed::FeederSet::beginStep: time = " << time << " is not finite";

@@ -206,7 +206,8 @@ void MotionLaw::validate(const std::string& where) const {
   profile_.validate(where);
 }
 
-StepLaw MotionLaw::evaluate(double t, const Pose* body_pose) const {
+StepLaw MotionLaw::evaluate(double t, const Pose* body_pose, double step) const {
+  (void)step;  // TODO(issue 7): secant surface velocity of rotating twists
   StepLaw s;
   s.time_ = t;
   s.scale_ = profile_(t);

@@ -64,7 +64,7 @@ class ContactCollider {
 
   /// One step's collision at simulation time `time` (s): empties the joint group, calls
   /// feeders.beginStep(time), collides `space` (recursing into sub-spaces) and creates joints.
-  void collide(dSpaceID space, double time);
+  void collide(dSpaceID space, double time, double step = 0.0);
   /// Empties the contact joint group (collide does it).
   void clearJoints();
   /// A dNearCallback; `data` must be a ContactCollider*.

@@ -148,9 +148,12 @@ class FeederSet {
   /// Number of registered feeders.
   int size() const;
 
-  /// Start a step at simulation time `time` (s): call once per step before collision. Laws are
-  /// frozen lazily at this time on their first contact. Throws if time is not finite.
-  void beginStep(double time);
+  /// Start a step at simulation time `time` (s) of length `step` (s): call once per step before
+  /// collision. Laws are frozen lazily at this time on their first contact. With `step` > 0 a
+  /// rotating law gives the secant surface velocity over the step, so a part sticking to a
+  /// turntable stays on its circle; `step` = 0 gives the instantaneous w x r. Throws if time is
+  /// not finite or step is negative or not finite.
+  void beginStep(double time, double step = 0.0);
   /// The time given to the latest beginStep (s).
   double time() const;
 

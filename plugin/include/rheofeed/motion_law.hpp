@@ -137,9 +137,11 @@ class MotionLaw {
   /// e.g. "feeder 0x55d0: law twist.linear.x = nan is not finite".
   void validate(const std::string& where) const;
 
-  /// Freeze the law at time `t` (s). `body_pose` is the pose of the body carrying the feeder
-  /// (needed for Frame::Body, ignored otherwise; nullptr means the world frame).
-  StepLaw evaluate(double t, const Pose* body_pose) const;
+  /// Freeze the law at time `t` (s) for a step of `step` seconds. `body_pose` is the pose of the
+  /// body carrying the feeder (needed for Frame::Body, ignored otherwise; nullptr means the world
+  /// frame). With `step` > 0 a rotating twist gives the secant surface velocity over the step
+  /// (see StepLaw::tangentialVelocity); `step` = 0 gives the instantaneous field v + w x (p - O).
+  StepLaw evaluate(double t, const Pose* body_pose, double step = 0.0) const;
 
  private:
   Kind kind_ = Kind::Twist;

@@ -25,6 +25,7 @@ class PartSimulation : public Simulation {
   double partMass(int index) const final;
   ContactTotals contactTotals() const final { return totals_; }
   Method method() const final { return method_; }
+  const RunHealth& health() const final { return health_; }
 
  protected:
   PartSimulation(const Scene& scene, Method method);
@@ -45,6 +46,7 @@ class PartSimulation : public Simulation {
   void addFixtureGeom(dGeomID geom) { fixture_geoms_.insert(geom); }
 
   const Scene scene_;
+  RunHealth health_;
 
  private:
   const Method method_;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "rheofeed/scene/scene.hpp"
@@ -30,6 +31,42 @@ struct ContactTotals {
   Vec3 impulse;               ///< sum of impulse vectors on the first geom's body (N s, world)
 };
 
+/// What a run lost, could not trust or ignored, counted since the start (issue 7: no silent
+/// failure). Every count is also reported on stderr when it first becomes non-zero and written
+/// into the run's JSON and CSV outputs.
+struct RunHealth {
+  long steps = 0;  ///< steps taken
+  /// Parts removed below Scene::removal_height after crossing the exit plane: normal flow.
+  int parts_exited = 0;
+  /// Parts removed below Scene::removal_height without crossing the exit plane (fell off an
+  /// edge, or over a wall or rim).
+  int parts_fell = 0;
+  /// Parts whose centre crossed a fixture surface within one step (tunnelling: through a floor
+  /// or a wall). They stay in the simulation; each part is counted once.
+  int parts_through_fixture = 0;
+  /// Parts removed because they left the scene bounds (far beyond the fixtures) sideways or up.
+  int parts_out_of_bounds = 0;
+  /// Parts whose state (position, velocity, angular velocity, orientation) became NaN or
+  /// infinite; they are removed at once.
+  int parts_nonfinite = 0;
+  /// Parts that went faster than the scene's physical speed bound (energy blow-up); counted
+  /// once each, then removed.
+  int parts_too_fast = 0;
+  /// Reference engine: steps whose true-Coulomb fixed point did not settle and that used the
+  /// fallback (0 for ODE), and steps whose contact solve stopped at the iteration limit.
+  long coulomb_fallback_steps = 0;
+  long solver_unconverged_steps = 0;
+  /// Settings of the scene this engine does not use (e.g. "solver.coulomb_iterations = 10:
+  /// ignored by ODE"), reported once at the start.
+  std::vector<std::string> ignored_settings;
+  /// Parts lost in any way but the exit: fell + through_fixture + out_of_bounds + nonfinite +
+  /// too_fast.
+  int partsLost() const {
+    return parts_fell + parts_through_fixture + parts_out_of_bounds + parts_nonfinite +
+           parts_too_fast;
+  }
+};
+
 class Simulation {
  public:
   virtual ~Simulation() = default;
@@ -48,6 +85,8 @@ class Simulation {
   /// Contact totals of the last step (impulses of the contacts touching parts).
   virtual ContactTotals contactTotals() const = 0;
   virtual Method method() const = 0;
+  /// What the run lost, could not trust or ignored so far.
+  virtual const RunHealth& health() const = 0;
 };
 
 /// Builds the scene for `method`. Throws std::invalid_argument for an invalid scene or a
