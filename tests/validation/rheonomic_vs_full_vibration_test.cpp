@@ -63,8 +63,8 @@ TEST(RheonomicVsFullVibration, CalibratedDriftConveysACluster) {
   EXPECT_NEAR(ode.mean_drift, full.mean_drift, kDriftTolerance * std::abs(full.mean_drift))
       << "full vibration " << full.mean_drift << " m/s, calibrated " << cal.value;
   EXPECT_NEAR(ref.mean_drift, full.mean_drift, kDriftTolerance * std::abs(full.mean_drift));
-  // And far cheaper: 100x larger steps.
-  EXPECT_LT(ode.cpu_seconds, full.cpu_seconds);
+  // The cost ratio (100x larger steps) is measured by demos/feeder_study, not asserted here:
+  // tests never assert on time.
 }
 
 // The quick estimate (classical single-part model) and the sampling calibration (a short ODE
