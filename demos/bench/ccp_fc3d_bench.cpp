@@ -2,7 +2,7 @@
 //
 // PGS vs APGD on the Siconos fc3d problems.
 //
-// For every *.dat file of a directory (e.g. shared/data/fc3d), solves the relaxed cone
+// For every *.dat file of a directory (e.g. tests/data/fc3d), solves the relaxed cone
 // complementarity problem from a cold start with block PGS and with APGD until the natural map
 // residual (see rheofeed/ccp/solver.hpp) reaches the tolerance, and prints one Markdown table and
 // the same data as CSV:

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Both solvers on every Siconos fc3d problem of shared/data/fc3d (see its README): the relaxed
+// Both solvers on every Siconos fc3d problem of tests/data/fc3d (see its README): the relaxed
 // natural map residual, recomputed here from the returned impulses, must reach 1e-8, and PGS and
 // APGD must agree on the velocities u = W gamma + q and on the objective (gamma itself is not
 // unique: W is rank deficient in the box stack and the Capsules problem).
@@ -92,7 +92,7 @@ fs::path dataDir() {
 TEST(Fc3dData, DirectoryHoldsExactlyTheKnownProblems) {
   ASSERT_TRUE(fs::is_directory(dataDir()))
       << "fc3d data directory not found: " << dataDir()
-      << " (configure with -DRHEOFEED_FC3D_DIR=<shared/data/fc3d>)";
+      << " (configure with -DRHEOFEED_FC3D_DIR=<folder of the .dat files>)";
   std::vector<std::string> found;
   for (const fs::directory_entry& entry : fs::directory_iterator(dataDir())) {
     if (entry.path().extension() == ".dat") found.push_back(entry.path().filename().string());
