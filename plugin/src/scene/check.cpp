@@ -40,6 +40,10 @@ constexpr double kUprightCosine = 1 - 1e-9;
 // check warns for any stack. Below X = 5 (not measured) it warns for any ratio above 1.
 // Measured with the throwaway probe of check_test.cpp's comment (MassRatioProbe), ODE 0.16:
 //   rheofeed_scene_tests --gtest_also_run_disabled_tests --gtest_filter='*MassRatioProbe*'
+// Quickstep shuffles its constraint rows with ODE's global random generator, so the boundary
+// moves from run to run: a repeat of X = 20, k = 20 crushed a stack at R = 7, the table's entry.
+// The limit used is the table's times this margin.
+constexpr double kRandomOrderMargin = 0.5;
 constexpr double kRatioX[] = {5, 10, 20, 50, 100, 200, 500, 2000, 8000};
 constexpr int kOdeIterations[] = {10, 20, 50, 100, 200};
 constexpr double kOdeHolds[9][5] = {
@@ -449,8 +453,8 @@ const char* toString(Hazard::Kind kind) {
 }
 
 double odeQuickstepMassRatioLimit(int iterations, double thickness, double time_step, double g) {
-  return tableLimit(kRatioX, kOdeIterations, kOdeHolds, thickness / (g * time_step * time_step),
-                    iterations);
+  return kRandomOrderMargin * tableLimit(kRatioX, kOdeIterations, kOdeHolds,
+                                         thickness / (g * time_step * time_step), iterations);
 }
 
 double referenceMassRatioLimit(int iterations, double thickness, double time_step, double g) {

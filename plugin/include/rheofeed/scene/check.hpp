@@ -73,8 +73,8 @@ std::string formatHazards(const std::vector<Hazard>& hazards, const std::string&
 /// quarter of the light part's thickness) with ODE's quickstep at `iterations` and a light
 /// part of thickness `thickness` (m) at step `time_step` (s) under gravity `g` (m/s^2), from
 /// the measured table in check.cpp (conservative: the measured grid point at or below the
-/// arguments). Returns 1 below the measured grid (any ratio above 1 warns) and 0 where even
-/// equal masses were crushed (any stack warns).
+/// arguments, halved for quickstep's random constraint order). Returns 1 below the measured grid
+/// (any ratio above 1 warns) and 0 where even equal masses were crushed (any stack warns).
 double odeQuickstepMassRatioLimit(int iterations, double thickness, double time_step, double g);
 
 /// As odeQuickstepMassRatioLimit for the reference solver (CCP, APGD or PGS, `iterations` =
