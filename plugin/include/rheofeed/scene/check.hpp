@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: MIT
+/// @file check.hpp
+/// A scene check before the run (issue 7): the known hazards of a scene for one method, each
+/// with its numbers, where they come from (a JSON path of the scene file, as scene_io.hpp
+/// names values) and the setting that avoids it. The check reads the scene only; it never
+/// runs it. Units: SI (m, s, kg, m/s); heights are measured against gravity (along -gravity).
+///
+/// What is checked (each Hazard::Kind documents its criterion and where its limit comes from):
+/// tunnelling at the expected part speed, walls that end flush with a floor, mass ratios beyond
+/// what the solver's iteration count holds, coarse full-vibration steps, spawn regions inside
+/// fixtures or below the removal height, and settings the engine ignores.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rheofeed/scene/scene.hpp"
+
+namespace rheofeed::scene {
+
+/// One warning of the scene check.
+struct Hazard {
+  enum class Kind {
+    /// A part at the scene's expected speed moves, in one step, further than half the summed
+    /// thickness of the thinnest fixture geom and the thinnest part: its centre then crosses
+    /// the fixture's mid-surface within one step, the collider's least-penetration normal
+    /// points out of the far side and the part is pushed through (or it skips the fixture).
+    Tunnelling,
+    /// A box standing on another box (overlapping it in plan) whose bottom lies less than the
+    /// thinnest part's thickness below the other's top (or above it): a thin part slips into
+    /// the seam and under the wall.
+    FlushWall,
+    /// Heaviest / lightest part mass beyond what the iteration count transmits through a stack
+    /// (measured boundary, see check.cpp): the light part is crushed into the floor or passed.
+    MassRatio,
+    /// Full vibration: fewer than kMinStepsPerCycle steps per vibration period.
+    CoarseVibrationStep,
+    /// A spawn region reaches into a fixture geom: parts start inside it.
+    SpawnInsideFixture,
+    /// A spawn region lies below Scene::removal_height: parts are removed as they appear.
+    SpawnBelowRemoval,
+    /// A setting the engine of this method does not use (e.g. restitution in the reference).
+    IgnoredSetting,
+  };
+  Kind kind = Kind::Tunnelling;
+  std::string message;       ///< what is wrong, naming the values (SI units)
+  std::string where;         ///< JSON path(s) of the values, e.g. "parts[0].size[2]"
+  std::string safe_setting;  ///< what avoids it, e.g. "solver.time_step <= 0.0012 s"
+  double value = 0;          ///< the offending number (unit in `message`)
+  double limit = 0;          ///< the number it must not exceed (same unit)
+};
+
+/// Printable name of a hazard kind ("tunnelling", "flush_wall", ...).
+const char* toString(Hazard::Kind kind);
+
+/// Full-vibration runs need at least this many steps per vibration period (the vibrating
+/// fixture's secant velocity over one step averages the sine over the step: at 20 steps per
+/// cycle its peak is 1 - sin(pi / 20) / (pi / 20) = 0.4 % low and lags by half a step, 9 degrees).
+constexpr double kMinStepsPerCycle = 20;
+
+/// The known hazards of `scene` when run with `method`, grouped by kind. Uses
+/// scene.solver.time_step as the step of the run (the caller sets the step it will use). Mesh
+/// geoms and parts are measured only if their triangles are loaded (scene_io.hpp); otherwise
+/// their thickness is taken as 0 and the message says so. Does not validate the scene.
+std::vector<Hazard> checkScene(const Scene& scene, Method method);
+
+/// The hazards as text for stderr, one block per hazard:
+///   "<prefix>warning [<kind>] <where>: <message>\n<prefix>  safe: <safe_setting>\n".
+/// Empty for no hazards.
+std::string formatHazards(const std::vector<Hazard>& hazards, const std::string& prefix = "");
+
+/// The largest heaviest/lightest part mass ratio that a stack holds (penetration below a
+/// quarter of the light part's thickness) with ODE's quickstep at `iterations` and a light
+/// part of thickness `thickness` (m) at step `time_step` (s) under gravity `g` (m/s^2), from
+/// the measured table in check.cpp (conservative: the measured grid point at or below the
+/// arguments, halved for quickstep's random constraint order). Returns 1 below the measured grid
+/// (any ratio above 1 warns) and 0 where even equal masses were crushed (any stack warns).
+double odeQuickstepMassRatioLimit(int iterations, double thickness, double time_step, double g);
+
+/// As odeQuickstepMassRatioLimit for the reference solver (CCP, APGD or PGS, `iterations` =
+/// the CCP iteration budget).
+double referenceMassRatioLimit(int iterations, double thickness, double time_step, double g);
+
+}  // namespace rheofeed::scene

@@ -1,0 +1,808 @@
+// SPDX-License-Identifier: MIT
+// The scene check before the run (check.hpp). Every criterion is stated next to its code; the
+// mass-ratio limits are measured, and the command that measures them is given with the table.
+#include "rheofeed/scene/check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "rheofeed/scene/mesh.hpp"
+
+namespace rheofeed::scene {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// A size distribution is taken to reach mean +- 5 standard deviations (within min/max): a
+// draw lies beyond with probability 5.7e-7, once in 580 scenes of 1000 boxes.
+constexpr double kSigmas = 5;
+// Two faces closer than this (m) are one seam for the flush-wall check, whatever the parts.
+constexpr double kSeamTolerance = 1e-6;
+// A box edge counts as upright when its direction is within this of the up direction (cosine).
+constexpr double kUprightCosine = 1 - 1e-9;
+
+// ---------------------------------------------------------------------------------------------
+// Mass-ratio limits, measured. A light cube on a floor box (top z = 0), a heavy cube of the same
+// edge e dropped on it from 0.8 e above, densities 1000 and 1000 R kg/m^3, mu 0.5, the scene
+// layer's defaults (ERP 0.2, CFM 1e-5, max correcting velocity 0.5 m/s, no surface layer), run
+// 2 s; the stack holds if the larger of (light into floor, heavy into light) stays below e / 4
+// during the second second (it either stays below 1.5 mm or the heavy part passes the light
+// one completely). The step h is chosen to give X = e / (g h^2), the light part's thickness in
+// units of the distance gravity moves it in one step; X, not e or h alone, sets the boundary
+// (within a factor of 2 for e = 2, 10 and 50 mm). Entries: the largest ratio R on the grid
+// 1, 1.5, 2, 3, 5, 7, 10, 15, 20, 30, 50, ... that held; the minimum over the edges measured
+// (2, 10, 50 mm for X = 5, 20, 100, 500; 10 mm elsewhere). Below X = 20 the probe's drop
+// itself moves the heavy part by 0.5-0.8 thicknesses in its landing step, so the X = 5 and 10
+// rows are lower bounds; equal 2 mm cubes were crushed at X = 5 (k = 100), so below X = 10 the
+// check warns for any stack. Below X = 5 (not measured) it warns for any ratio above 1.
+// Measured with the throwaway probe of check_test.cpp's comment (MassRatioProbe), ODE 0.16:
+//   rheofeed_scene_tests --gtest_also_run_disabled_tests --gtest_filter='*MassRatioProbe*'
+// Quickstep shuffles its constraint rows with ODE's global random generator, so the boundary
+// moves from run to run: a repeat of X = 20, k = 20 crushed a stack at R = 7, the table's entry.
+// The limit used is the table's times this margin.
+constexpr double kRandomOrderMargin = 0.5;
+constexpr double kRatioX[] = {5, 10, 20, 50, 100, 200, 500, 2000, 8000};
+constexpr int kOdeIterations[] = {10, 20, 50, 100, 200};
+constexpr double kOdeHolds[9][5] = {
+    {3, 1, 2, 0, 5},              // X = 5 (drop-affected; 0: equal 2 mm cubes crushed)
+    {3, 7, 15, 30, 70},           // X = 10 (10 mm only; drop-affected)
+    {7, 7, 15, 30, 100},          // X = 20
+    {10, 20, 30, 70, 200},        // X = 50 (10 mm only)
+    {20, 20, 30, 70, 300},        // X = 100
+    {30, 50, 70, 150, 300},       // X = 200 (10 mm only)
+    {50, 50, 100, 300, 700},      // X = 500
+    {100, 200, 300, 1000, 2000},  // X = 2000 (10 mm only)
+    {300, 500, 1500, 2000, 3000}  // X = 8000 (10 mm only)
+};
+// The reference solver (APGD, tolerance 1e-6, 10 Coulomb iterations), 10 mm cubes, X = 20,
+// 100, 500 only; 1e4 = no crush up to 1e4. It holds 5-30 times the ratio of ODE quickstep at
+// the same iteration count, but not monotonically: a 20 mm stack at h = 0.01 s, k = 50 was
+// crushed at R = 50 and held at R = 100 (the Coulomb fallback, issue 7).
+constexpr double kRefX[] = {20, 100, 500};
+constexpr int kRefIterations[] = {20, 50, 100};
+constexpr double kRefHolds[3][3] = {
+    {100, 500, 2000},   // X = 20
+    {200, 3000, 5000},  // X = 100
+    {200, 1500, 1e4},   // X = 500
+};
+
+// The measured limit at the grid point at or below (X, k), taken as the minimum over every grid
+// point at or above it, so that a non-monotone measurement never raises the limit.
+template <std::size_t NX, std::size_t NK>
+double tableLimit(const double (&xs)[NX], const int (&ks)[NK], const double (&holds)[NX][NK],
+                  double x, int k) {
+  if (!(x >= xs[0]) || k < ks[0]) return 1;  // below the grid: any ratio above 1 warns
+  std::size_t i0 = 0, j0 = 0;
+  while (i0 + 1 < NX && xs[i0 + 1] <= x) ++i0;
+  while (j0 + 1 < NK && ks[j0 + 1] <= k) ++j0;
+  double limit = kInf;
+  for (std::size_t i = i0; i < NX; ++i) {
+    for (std::size_t j = j0; j < NK; ++j) limit = std::min(limit, holds[i][j]);
+  }
+  return limit;
+}
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+std::string mm(double metres) {
+  return fmt(1000 * metres) + " mm";
+}
+std::string idx(const char* base, std::size_t i) {
+  return base + ("[" + std::to_string(i) + "]");
+}
+std::string geomPath(std::size_t f, std::size_t g) {
+  return idx("fixtures", f) + "." + idx("geoms", g);
+}
+
+// Axis-aligned bounding box (world) of a fixture geom; planes are unbounded.
+struct Box3 {
+  Vec3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
+  bool bounded = true;
+  void add(const Vec3& p) {
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+};
+
+double component(const Vec3& v, int i) {
+  return i == 0 ? v.x : (i == 1 ? v.y : v.z);
+}
+
+Box3 geomBounds(const Fixture::Geom& g) {
+  Box3 b;
+  const Shape& s = g.shape;
+  const double* r = g.pose.rotation;
+  auto rounded = [&](double half_length, double radius, double cap) {
+    // Segment along local z of half length `half_length`, swept by a disc (cylinder, cap = 0)
+    // or a ball (capsule, cap = 1) of radius `radius`.
+    Vec3 half;
+    for (int i = 0; i < 3; ++i) {
+      const double az = std::abs(r[3 * i + 2]);
+      const double disc = radius * std::sqrt(std::max(0.0, 1 - az * az));
+      const double e = half_length * az + (cap > 0 ? radius : disc);
+      (i == 0 ? half.x : (i == 1 ? half.y : half.z)) = e;
+    }
+    b.add(g.pose.position - half);
+    b.add(g.pose.position + half);
+  };
+  switch (s.kind) {
+    case Shape::Kind::Box:
+      for (int c = 0; c < 8; ++c) {
+        const Vec3 local{(c & 1 ? 0.5 : -0.5) * s.size.x, (c & 2 ? 0.5 : -0.5) * s.size.y,
+                         (c & 4 ? 0.5 : -0.5) * s.size.z};
+        b.add(g.pose.transform(local));
+      }
+      break;
+    case Shape::Kind::Sphere:
+      b.add(g.pose.position - Vec3{s.radius, s.radius, s.radius});
+      b.add(g.pose.position + Vec3{s.radius, s.radius, s.radius});
+      break;
+    case Shape::Kind::Cylinder:
+      rounded(0.5 * s.length, s.radius, 0);
+      break;
+    case Shape::Kind::Capsule:
+      rounded(0.5 * s.length, s.radius, 1);
+      break;
+    case Shape::Kind::Plane:
+      b.bounded = false;
+      break;
+    case Shape::Kind::Mesh:
+      if (s.mesh_data) {
+        const std::vector<double>& v = s.mesh_data->vertices;
+        for (std::size_t k = 0; k + 2 < v.size(); k += 3) {
+          b.add(g.pose.transform({v[k], v[k + 1], v[k + 2]}));
+        }
+      } else {
+        b.bounded = false;
+      }
+      break;
+  }
+  return b;
+}
+
+// Heights along `up` of a box's extremes.
+double maxAlong(const Box3& b, const Vec3& up) {
+  return std::max(b.lo.x * up.x, b.hi.x * up.x) + std::max(b.lo.y * up.y, b.hi.y * up.y) +
+         std::max(b.lo.z * up.z, b.hi.z * up.z);
+}
+double minAlong(const Box3& b, const Vec3& up) {
+  return -maxAlong(b, -up);
+}
+
+// Wall thickness of a closed triangle mesh (m): from the centroid of every triangle a ray goes
+// inwards (against the outward normal); the nearest other triangle it meets is the wall's far
+// side there. Returned: the thickness below which lies kThinShare of the surface area, not
+// the minimum, which a vanishing wedge (the start of a ramp that rises from a floor) takes to
+// zero, and which overlapping shells make the overlap (demos/meshes/vibratory_bowl.stl: its
+// ramp overlaps the wall by 1 mm over 2 % of the area; its thinnest real wall, the 4 mm ramp,
+// is 19 %). A crude estimate: a thin wall covering less than 5 % of a mesh is not seen.
+// O(n^2) in the triangles: 3000 triangles take about 0.1 s.
+constexpr double kThinShare = 0.05;
+double meshWallThickness(const TriangleMesh& mesh, double scale) {
+  const std::vector<double>& v = mesh.vertices;
+  const std::vector<int>& t = mesh.triangles;
+  auto vert = [&](int i) { return scale * Vec3{v[3 * i], v[3 * i + 1], v[3 * i + 2]}; };
+  const std::size_t n = t.size() / 3;
+  std::vector<std::pair<double, double>> walls;  // thickness, area
+  double total_area = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 a = vert(t[3 * i]), b = vert(t[3 * i + 1]), c = vert(t[3 * i + 2]);
+    const Vec3 normal = cross(b - a, c - a);
+    const double area2 = norm(normal);
+    if (!(area2 > 0)) continue;
+    const Vec3 dir = (-1.0 / area2) * normal;  // inwards
+    const Vec3 origin = (1.0 / 3.0) * (a + b + c);
+    double nearest = kInf;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j == i) continue;
+      // Moller-Trumbore ray/triangle intersection.
+      const Vec3 p = vert(t[3 * j]), q = vert(t[3 * j + 1]), r = vert(t[3 * j + 2]);
+      const Vec3 e1 = q - p, e2 = r - p, pv = cross(dir, e2);
+      const double det = dot(e1, pv);
+      if (std::abs(det) < 1e-30) continue;
+      const Vec3 tv = origin - p;
+      const double u = dot(tv, pv) / det;
+      if (u < 0 || u > 1) continue;
+      const Vec3 qv = cross(tv, e1);
+      const double w = dot(dir, qv) / det;
+      if (w < 0 || u + w > 1) continue;
+      const double dist = dot(e2, qv) / det;
+      if (dist > 1e-9 * std::sqrt(area2)) nearest = std::min(nearest, dist);
+    }
+    total_area += 0.5 * area2;
+    if (std::isfinite(nearest)) walls.emplace_back(nearest, 0.5 * area2);
+  }
+  std::sort(walls.begin(), walls.end());
+  double area = 0;
+  for (const auto& [thickness, a] : walls) {
+    area += a;
+    if (area >= kThinShare * total_area) return thickness;
+  }
+  return walls.empty() ? 0 : walls.back().first;
+}
+
+// Smallest extent of a mesh's bounding box in its own frame, times `scale` (m).
+double meshBoxExtent(const TriangleMesh& mesh, double scale) {
+  Box3 b;
+  for (std::size_t k = 0; k + 2 < mesh.vertices.size(); k += 3) {
+    b.add({mesh.vertices[k], mesh.vertices[k + 1], mesh.vertices[k + 2]});
+  }
+  const Vec3 e = b.hi - b.lo;
+  return scale * std::min({e.x, e.y, e.z});
+}
+
+// Thickness of a fixture geom (m): the smallest distance across it. Planes are half-spaces.
+struct Thickness {
+  double value = kInf;
+  std::string note;
+};
+Thickness fixtureThickness(const Shape& s) {
+  switch (s.kind) {
+    case Shape::Kind::Box:
+      return {std::min({s.size.x, s.size.y, s.size.z}), ""};
+    case Shape::Kind::Sphere:
+    case Shape::Kind::Capsule:
+      return {2 * s.radius, ""};
+    case Shape::Kind::Cylinder:
+      return {std::min(2 * s.radius, s.length), ""};
+    case Shape::Kind::Plane:
+      return {kInf, ""};
+    case Shape::Kind::Mesh:
+      if (!s.mesh_data) return {0, " (mesh not loaded: counted as a surface of no thickness)"};
+      return {meshWallThickness(*s.mesh_data, 1.0),
+              " (mesh wall: 5 % of its area is thinner, by ray casting; a crude estimate)"};
+  }
+  return {};
+}
+
+// Range of a size distribution that drawParts can return (m).
+double sizeLow(const Distribution& d) {
+  return d.stddev > 0 ? std::max({d.min, d.mean - kSigmas * d.stddev, 1e-3 * d.mean}) : d.mean;
+}
+double sizeHigh(const Distribution& d) {
+  return d.stddev > 0 ? std::min(d.max, d.mean + kSigmas * d.stddev) : d.mean;
+}
+
+// Mass (kg) and smallest thickness (m) of a part of family `p` with sizes `sz`.
+struct PartExtreme {
+  double mass = 0, thickness = 0;
+};
+PartExtreme partExtreme(const PartSpec& p, const double sz[3], std::string* note) {
+  const double rho = p.density;
+  switch (p.shape) {
+    case Shape::Kind::Box:
+      return {rho * sz[0] * sz[1] * sz[2], std::min({sz[0], sz[1], sz[2]})};
+    case Shape::Kind::Sphere:
+      return {rho * 4.0 / 3.0 * kPi * std::pow(sz[0], 3), 2 * sz[0]};
+    case Shape::Kind::Cylinder:
+      return {rho * kPi * sz[0] * sz[0] * sz[1], std::min(2 * sz[0], sz[1])};
+    case Shape::Kind::Capsule:
+      return {rho * kPi * sz[0] * sz[0] * (sz[1] + 4.0 / 3.0 * sz[0]), 2 * sz[0]};
+    case Shape::Kind::Mesh:
+      if (!p.mesh_data) {
+        if (note) *note = " (mesh part not loaded: its mass and thickness are unknown)";
+        return {0, 0};
+      }
+      if (note) *note = " (mesh part: smallest bounding-box extent, an upper bound)";
+      return {massProperties(*p.mesh_data, rho).mass * std::pow(sz[0], 3),
+              meshBoxExtent(*p.mesh_data, sz[0])};
+    case Shape::Kind::Plane:
+      break;
+  }
+  return {};
+}
+
+struct PartRange {
+  PartExtreme light, heavy;  // the lightest and heaviest parts of the family
+  double thinnest = 0;       // smallest thickness of any part of the family (m)
+  std::string note;
+};
+PartRange partRange(const PartSpec& p) {
+  const int n = partSizeCount(p.shape);
+  double lo[3], hi[3];
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = d < n ? sizeLow(p.size[d]) : 0;
+    hi[d] = d < n ? sizeHigh(p.size[d]) : 0;
+  }
+  PartRange r;
+  r.light = partExtreme(p, lo, &r.note);
+  r.heavy = partExtreme(p, hi, nullptr);
+  // The thinnest part: every size at its low end but a cylinder's length (min(2r, L)) is
+  // also lowest there, so the light part is the thinnest.
+  r.thinnest = r.light.thickness;
+  return r;
+}
+
+// 2D overlap area test of two upright boxes projected on the plane normal to `up`
+// (separating axes: the boxes' in-plane edges).
+bool planOverlap(const Fixture::Geom& a, const Fixture::Geom& b, const Vec3& up) {
+  auto axes = [&](const Fixture::Geom& g, Vec3 out[3], double half[3]) {
+    const double* r = g.pose.rotation;
+    const double size[3] = {g.shape.size.x, g.shape.size.y, g.shape.size.z};
+    for (int c = 0; c < 3; ++c) {
+      out[c] = {r[c], r[3 + c], r[6 + c]};
+      half[c] = 0.5 * size[c];
+    }
+  };
+  Vec3 ax[3], bx[3];
+  double ah[3], bh[3];
+  axes(a, ax, ah);
+  axes(b, bx, bh);
+  auto radius = [&](const Vec3 e[3], const double h[3], const Vec3& dir) {
+    double s = 0;
+    for (int c = 0; c < 3; ++c) {
+      if (std::abs(dot(e[c], up)) < kUprightCosine) s += h[c] * std::abs(dot(e[c], dir));
+    }
+    return s;
+  };
+  const Vec3 d = b.pose.position - a.pose.position;
+  for (const Vec3* set : {ax, bx}) {
+    for (int c = 0; c < 3; ++c) {
+      if (std::abs(dot(set[c], up)) >= kUprightCosine) continue;
+      const double gap = std::abs(dot(d, set[c])) - radius(ax, ah, set[c]) - radius(bx, bh, set[c]);
+      if (gap >= -kSeamTolerance) return false;  // touching edges are no overlap
+    }
+  }
+  return true;
+}
+
+bool upright(const Fixture::Geom& g, const Vec3& up) {
+  if (g.shape.kind != Shape::Kind::Box) return false;
+  const double* r = g.pose.rotation;
+  for (int c = 0; c < 3; ++c) {
+    if (std::abs(r[c] * up.x + r[3 + c] * up.y + r[6 + c] * up.z) >= kUprightCosine) return true;
+  }
+  return false;
+}
+
+// Whether the axis-aligned region [lo, hi] (world) reaches into a fixture geom.
+bool regionInsideGeom(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g) {
+  const Shape& s = g.shape;
+  if (s.kind == Shape::Kind::Plane) {
+    double lowest = kInf;  // the region's corner deepest below the plane
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 p{c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z};
+      lowest = std::min(lowest, dot(s.plane_normal, p) - s.plane_offset);
+    }
+    return lowest < 0;
+  }
+  if (s.kind == Shape::Kind::Mesh) return false;  // hollow in general: not checked
+  if (s.kind == Shape::Kind::Sphere) {
+    const Vec3 c = g.pose.position;
+    const Vec3 nearest{std::clamp(c.x, lo.x, hi.x), std::clamp(c.y, lo.y, hi.y),
+                       std::clamp(c.z, lo.z, hi.z)};
+    return norm(nearest - c) < s.radius;
+  }
+  const Box3 b = geomBounds(g);
+  const bool aabb = lo.x < b.hi.x && hi.x > b.lo.x && lo.y < b.hi.y && hi.y > b.lo.y &&
+                    lo.z < b.hi.z && hi.z > b.lo.z;
+  if (!aabb || s.kind != Shape::Kind::Box) return aabb;  // cylinder, capsule: bounding box
+  // Box: separating axes of two boxes (the region's 3, the geom's 3, their 9 cross products).
+  const double* r = g.pose.rotation;
+  const Vec3 ge[3] = {{r[0], r[3], r[6]}, {r[1], r[4], r[7]}, {r[2], r[5], r[8]}};
+  const double gh[3] = {0.5 * s.size.x, 0.5 * s.size.y, 0.5 * s.size.z};
+  const Vec3 re[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const double rh[3] = {0.5 * (hi.x - lo.x), 0.5 * (hi.y - lo.y), 0.5 * (hi.z - lo.z)};
+  const Vec3 d = g.pose.position - 0.5 * (lo + hi);
+  auto separated = [&](const Vec3& axis) {
+    if (!(norm(axis) > 1e-12)) return false;
+    double ra = 0, rb = 0;
+    for (int c = 0; c < 3; ++c) {
+      ra += rh[c] * std::abs(dot(re[c], axis));
+      rb += gh[c] * std::abs(dot(ge[c], axis));
+    }
+    return std::abs(dot(d, axis)) >= ra + rb;
+  };
+  for (int i = 0; i < 3; ++i) {
+    if (separated(re[i]) || separated(ge[i])) return false;
+    for (int j = 0; j < 3; ++j) {
+      if (separated(cross(re[i], ge[j]))) return false;
+    }
+  }
+  return true;
+}
+
+// Largest surface speed of a drift twist over a box (m/s): |v + w x (c - O)| is convex in c,
+// so its maximum over the box is at a corner.
+double twistSpeedOver(const Twist& t, const Box3& b) {
+  double fastest = norm(t.linear);
+  if (!b.bounded) return isZero(t.angular) ? fastest : kInf;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 p{c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z};
+    fastest = std::max(fastest, norm(t.linear + cross(t.angular, p - t.origin)));
+  }
+  return fastest;
+}
+
+// Largest distance of a box's corners from an axis (m).
+double radiusFromAxis(const Box3& b, const Vec3& origin, const Vec3& axis) {
+  double r = 0;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 p{c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z};
+    r = std::max(r, norm(cross(axis, p - origin)));
+  }
+  return r;
+}
+
+}  // namespace
+
+const char* toString(Hazard::Kind kind) {
+  switch (kind) {
+    case Hazard::Kind::Tunnelling:
+      return "tunnelling";
+    case Hazard::Kind::FlushWall:
+      return "flush_wall";
+    case Hazard::Kind::MassRatio:
+      return "mass_ratio";
+    case Hazard::Kind::CoarseVibrationStep:
+      return "coarse_vibration_step";
+    case Hazard::Kind::SpawnInsideFixture:
+      return "spawn_inside_fixture";
+    case Hazard::Kind::SpawnBelowRemoval:
+      return "spawn_below_removal";
+    case Hazard::Kind::IgnoredSetting:
+      return "ignored_setting";
+  }
+  return "unknown";
+}
+
+double odeQuickstepMassRatioLimit(int iterations, double thickness, double time_step, double g) {
+  return kRandomOrderMargin * tableLimit(kRatioX, kOdeIterations, kOdeHolds,
+                                         thickness / (g * time_step * time_step), iterations);
+}
+
+double referenceMassRatioLimit(int iterations, double thickness, double time_step, double g) {
+  return tableLimit(kRefX, kRefIterations, kRefHolds, thickness / (g * time_step * time_step),
+                    iterations);
+}
+
+std::vector<Hazard> checkScene(const Scene& scene, Method method) {
+  std::vector<Hazard> out;
+  const double h = scene.solver.time_step;
+  const double g = norm(scene.gravity);
+  const Vec3 up = g > 0 ? (-1.0 / g) * scene.gravity : Vec3{0, 0, 1};
+  const bool full = isFullVibration(method);
+  const bool ode = method == Method::OdeRheonomic || method == Method::OdeFullVibration;
+
+  // Parts: the thinnest, the lightest and the heaviest over all families.
+  double thinnest_part = kInf, lightest = kInf, heaviest = 0, light_thickness = kInf;
+  std::size_t thin_family = 0, light_family = 0, heavy_family = 0;
+  std::string part_note;
+  int total_parts = 0;
+  for (std::size_t i = 0; i < scene.parts.size(); ++i) {
+    const PartRange r = partRange(scene.parts[i]);
+    total_parts += scene.parts[i].count;
+    if (r.thinnest < thinnest_part) {
+      thinnest_part = r.thinnest;
+      thin_family = i;
+      part_note = r.note;
+    }
+    if (r.light.mass > 0 && r.light.mass < lightest) {
+      lightest = r.light.mass;
+      light_thickness = r.light.thickness;
+      light_family = i;
+    }
+    if (r.heavy.mass > heaviest) {
+      heaviest = r.heavy.mass;
+      heavy_family = i;
+    }
+  }
+
+  // Fixtures: bounds, the thinnest geom, the lowest top, the fastest surface.
+  struct GeomInfo {
+    std::size_t f, g;
+    Box3 bounds;
+  };
+  std::vector<GeomInfo> geoms;
+  double thinnest_fixture = kInf, lowest_top = kInf;
+  std::string thin_geom, fixture_note;
+  double surface_speed = 0;
+  std::string speed_source = "nothing moves";
+  for (std::size_t f = 0; f < scene.fixtures.size(); ++f) {
+    const Fixture& fx = scene.fixtures[f];
+    Box3 all;
+    for (std::size_t k = 0; k < fx.geoms.size(); ++k) {
+      const Fixture::Geom& gm = fx.geoms[k];
+      const Box3 b = geomBounds(gm);
+      geoms.push_back({f, k, b});
+      if (b.bounded) {
+        all.add(b.lo);
+        all.add(b.hi);
+        lowest_top = std::min(lowest_top, maxAlong(b, up));
+      } else {
+        all.bounded = false;
+        if (gm.shape.kind == Shape::Kind::Plane && dot(gm.shape.plane_normal, up) > 0.5) {
+          lowest_top = std::min(lowest_top, gm.shape.plane_offset / dot(gm.shape.plane_normal, up));
+        }
+      }
+      const Thickness t = fixtureThickness(gm.shape);
+      if (t.value < thinnest_fixture) {
+        thinnest_fixture = t.value;
+        thin_geom = geomPath(f, k);
+        fixture_note = t.note;
+      }
+    }
+    const FeederLaw& law = fx.law;
+    double speed = 0;
+    std::string source;
+    switch (law.kind) {
+      case FeederLaw::Kind::None:
+        break;
+      case FeederLaw::Kind::Belt:
+        speed = std::abs(law.belt_speed);
+        source = idx("fixtures", f) + ".law.belt.speed";
+        break;
+      case FeederLaw::Kind::Drift:
+        speed = twistSpeedOver(law.drift, all);
+        source = idx("fixtures", f) + ".law.drift (over the fixture's extent)";
+        break;
+      case FeederLaw::Kind::Vibration: {
+        const Vibration& v = law.vibration;
+        if (full) {
+          const double w = 2 * kPi * v.frequency;
+          const double r = all.bounded ? radiusFromAxis(all, v.axis_origin, v.axis_direction) : 0;
+          speed = w * v.amplitude + w * v.torsion_amplitude * r;
+          source = idx("fixtures", f) + ".law.vibration (peak velocity 2 pi f (A + theta r))";
+        } else if (law.has_calibrated_drift) {
+          speed = twistSpeedOver(law.calibrated_drift, all);
+          source = idx("fixtures", f) + ".law.calibrated_drift (over the fixture's extent)";
+        }
+        break;
+      }
+    }
+    if (speed > surface_speed) {
+      surface_speed = speed;
+      speed_source = source;
+    }
+  }
+
+  // --- 1. Tunnelling -------------------------------------------------------------------------
+  {
+    double highest_spawn = -kInf, launch = 0;
+    std::size_t high_family = 0, launch_family = 0;
+    for (std::size_t i = 0; i < scene.parts.size(); ++i) {
+      const PartSpec& p = scene.parts[i];
+      Box3 region;
+      region.add(p.spawn_min);
+      region.add(p.spawn_max);
+      if (maxAlong(region, up) > highest_spawn) {
+        highest_spawn = maxAlong(region, up);
+        high_family = i;
+      }
+      if (norm(p.initial_velocity) > launch) {
+        launch = norm(p.initial_velocity);
+        launch_family = i;
+      }
+    }
+    const double fall = std::isfinite(lowest_top) ? std::max(0.0, highest_spawn - lowest_top) : 0;
+    const double fall_speed = std::sqrt(2 * g * fall);
+    double speed = fall_speed;
+    std::string source = "free fall of " + mm(fall) + " from " + idx("parts", high_family) +
+                         ".spawn_max to the lowest fixture top";
+    if (surface_speed > speed) {
+      speed = surface_speed;
+      source = speed_source;
+    }
+    if (launch > speed) {
+      speed = launch;
+      source = idx("parts", launch_family) + ".initial_velocity";
+    }
+    // Semi-implicit Euler: x+ = x + h (v + g h), so one step moves a part by h (v + g h).
+    const double travel = h * (speed + g * h);
+    // The centre of a part of thickness t pressed into a geom of thickness T crosses the
+    // geom's mid-surface at a penetration of (T + t) / 2; the collider's least-penetration
+    // normal then points out of the far side. Parts against parts: T = t.
+    const double across = std::min(thinnest_fixture, thinnest_part);
+    const double allowed = 0.5 * (across + thinnest_part);
+    if (std::isfinite(allowed) && travel > allowed) {
+      Hazard hz;
+      hz.kind = Hazard::Kind::Tunnelling;
+      hz.value = travel;
+      hz.limit = allowed;
+      const bool fixture_thinner = thinnest_fixture <= thinnest_part;
+      hz.where = "solver.time_step, " + idx("parts", thin_family) + ".size" +
+                 (fixture_thinner ? ", " + thin_geom : "");
+      std::ostringstream m;
+      m << "a part at the expected speed " << fmt(speed) << " m/s (" << source
+        << ") moves h (v + g h) = " << mm(travel) << " per step of " << fmt(h)
+        << " s, more than half the summed thickness of the thinnest "
+        << (fixture_thinner
+                ? "fixture geom " + thin_geom + " (" + mm(thinnest_fixture) + ")" + fixture_note
+                : std::string("part as obstacle"))
+        << " and the thinnest part " << idx("parts", thin_family) << " (" << mm(thinnest_part)
+        << ")" << part_note << ": " << mm(allowed) << "; parts can pass through";
+      hz.message = m.str();
+      // Largest h with h (v + g h) <= allowed.
+      const double safe_h =
+          g > 0 ? (-speed + std::sqrt(speed * speed + 4 * g * allowed)) / (2 * g) : allowed / speed;
+      std::ostringstream s;
+      s << "solver.time_step <= " << fmt(safe_h) << " s";
+      if (fixture_thinner) {
+        s << ", or make " << thin_geom << " at least "
+          << mm(std::max(0.0, 2 * travel - thinnest_part)) << " thick";
+      }
+      if (source.rfind("free fall", 0) == 0) s << ", or spawn the parts lower";
+      hz.safe_setting = s.str();
+      out.push_back(hz);
+    }
+  }
+
+  // --- 2. Walls that end flush with a floor ---------------------------------------------------
+  if (std::isfinite(thinnest_part)) {
+    for (const GeomInfo& wall : geoms) {
+      const Fixture::Geom& wg = scene.fixtures[wall.f].geoms[wall.g];
+      if (!upright(wg, up)) continue;
+      const double bottom = minAlong(wall.bounds, up);
+      for (const GeomInfo& floor : geoms) {
+        if (&floor == &wall) continue;
+        const Fixture::Geom& fg = scene.fixtures[floor.f].geoms[floor.g];
+        if (!upright(fg, up)) continue;
+        const double top = maxAlong(floor.bounds, up);
+        const double floor_bottom = minAlong(floor.bounds, up);
+        // The wall stands on the floor: its bottom within one thinnest part of the floor's top
+        // (sunk less than that, or above it by less than that), it rises above the floor and
+        // it does not start below the floor's bottom.
+        const double gap = bottom - top;  // > 0: open above the floor, < 0: sunk
+        if (!(gap > -thinnest_part + kSeamTolerance && gap < thinnest_part)) continue;
+        if (maxAlong(wall.bounds, up) <= top || bottom <= floor_bottom) continue;
+        if (!planOverlap(wg, fg, up)) continue;
+        Hazard hz;
+        hz.kind = Hazard::Kind::FlushWall;
+        hz.value = gap;
+        hz.limit = -thinnest_part;
+        hz.where = geomPath(wall.f, wall.g) + ", " + geomPath(floor.f, floor.g) + ", " +
+                   idx("parts", thin_family) + ".size";
+        std::ostringstream m;
+        m << "the bottom of " << geomPath(wall.f, wall.g) << " (fixture '"
+          << scene.fixtures[wall.f].name << "') is "
+          << (gap >= 0 ? mm(gap) + " above" : mm(-gap) + " below") << " the top of "
+          << geomPath(floor.f, floor.g) << " (fixture '" << scene.fixtures[floor.f].name
+          << "'), less than the thinnest part " << idx("parts", thin_family) << " ("
+          << mm(thinnest_part) << "): a thin part can slip into the seam and under the wall";
+        hz.message = m.str();
+        hz.safe_setting = "extend " + geomPath(wall.f, wall.g) + " " + mm(thinnest_part + gap) +
+                          " further down (its bottom " + mm(thinnest_part) +
+                          " below the floor's top), or make them one fixture";
+        out.push_back(hz);
+      }
+    }
+  }
+
+  // --- 3. Mass ratios beyond the iteration count --------------------------------------------
+  const bool quickstep = ode && scene.solver.ode_quickstep;
+  if ((quickstep || !ode) && total_parts >= 2 && lightest < kInf && heaviest > 0) {
+    const double ratio = heaviest / lightest;
+    const int k = scene.solver.iterations;
+    const double limit = quickstep ? odeQuickstepMassRatioLimit(k, light_thickness, h, g)
+                                   : referenceMassRatioLimit(k, light_thickness, h, g);
+    if (ratio > limit) {
+      Hazard hz;
+      hz.kind = Hazard::Kind::MassRatio;
+      hz.value = ratio;
+      hz.limit = limit;
+      hz.where = idx("parts", heavy_family) + ".size, " + idx("parts", light_family) +
+                 ".size, density, solver.iterations, solver.time_step";
+      const double x = light_thickness / (g * h * h);
+      std::ostringstream m;
+      m << "the heaviest part (" << idx("parts", heavy_family) << ", " << fmt(heaviest)
+        << " kg) is " << fmt(ratio) << " times the lightest (" << idx("parts", light_family) << ", "
+        << fmt(lightest) << " kg, " << mm(light_thickness) << " thick); "
+        << (quickstep ? "ODE quickstep" : "the reference solver") << " with " << k
+        << " iterations at h = " << fmt(h) << " s (thickness / (g h^2) = " << fmt(x)
+        << ") was measured to hold a ratio of " << fmt(limit)
+        << ": a heavy part resting on a light one crushes it into the floor";
+      hz.message = m.str();
+      std::ostringstream s;
+      int need = 0;
+      for (int kk :
+           quickstep ? std::vector<int>{10, 20, 50, 100, 200} : std::vector<int>{20, 50, 100}) {
+        const double l = quickstep ? odeQuickstepMassRatioLimit(kk, light_thickness, h, g)
+                                   : referenceMassRatioLimit(kk, light_thickness, h, g);
+        if (!need && ratio <= l) need = kk;
+      }
+      if (need) s << "solver.iterations >= " << need << ", or ";
+      double safe_h = h;
+      for (int n = 0;
+           n < 60 && ratio > (quickstep ? odeQuickstepMassRatioLimit(k, light_thickness, safe_h, g)
+                                        : referenceMassRatioLimit(k, light_thickness, safe_h, g));
+           ++n) {
+        safe_h *= 0.8;
+      }
+      s << "solver.time_step <= " << fmt(safe_h) << " s";
+      if (quickstep) s << ", or solver.ode_quickstep = false (Dantzig LCP, exact but slower)";
+      s << ", or parts of closer masses";
+      hz.safe_setting = s.str();
+      out.push_back(hz);
+    }
+  }
+
+  // --- 4. Coarse full-vibration steps ---------------------------------------------------------
+  if (full) {
+    for (std::size_t f = 0; f < scene.fixtures.size(); ++f) {
+      const FeederLaw& law = scene.fixtures[f].law;
+      if (law.kind != FeederLaw::Kind::Vibration) continue;
+      const double per_cycle = 1.0 / (law.vibration.frequency * h);
+      if (per_cycle >= kMinStepsPerCycle) continue;
+      Hazard hz;
+      hz.kind = Hazard::Kind::CoarseVibrationStep;
+      hz.value = per_cycle;
+      hz.limit = kMinStepsPerCycle;
+      hz.where = "solver.time_step, " + idx("fixtures", f) + ".law.vibration.frequency";
+      hz.message = "a full-vibration run resolves the " + fmt(law.vibration.frequency) +
+                   " Hz vibration of fixture '" + scene.fixtures[f].name + "' with only " +
+                   fmt(per_cycle) + " steps per cycle (h = " + fmt(h) + " s)";
+      hz.safe_setting =
+          "solver.time_step <= " + fmt(1.0 / (kMinStepsPerCycle * law.vibration.frequency)) + " s";
+      out.push_back(hz);
+    }
+  }
+
+  // --- 5. Spawn regions inside fixtures or below the removal height ---------------------------
+  for (std::size_t i = 0; i < scene.parts.size(); ++i) {
+    const PartSpec& p = scene.parts[i];
+    for (const GeomInfo& gi : geoms) {
+      const Fixture::Geom& gm = scene.fixtures[gi.f].geoms[gi.g];
+      if (!regionInsideGeom(p.spawn_min, p.spawn_max, gm)) continue;
+      Hazard hz;
+      hz.kind = Hazard::Kind::SpawnInsideFixture;
+      hz.where = idx("parts", i) + ".spawn_min, " + idx("parts", i) + ".spawn_max, " +
+                 geomPath(gi.f, gi.g);
+      hz.message = "the spawn region of " + idx("parts", i) + " ('" + p.name + "') reaches into " +
+                   geomPath(gi.f, gi.g) + " (" + toString(gm.shape.kind) + ", fixture '" +
+                   scene.fixtures[gi.f].name +
+                   "'): parts can start inside it and are pushed out at up to "
+                   "solver.max_correcting_velocity or through it";
+      hz.safe_setting = "move or shrink " + idx("parts", i) +
+                        ".spawn_min/spawn_max so that part centres stay outside every fixture "
+                        "(at least half a part above a floor)";
+      out.push_back(hz);
+    }
+    Box3 region;
+    region.add(p.spawn_min);
+    region.add(p.spawn_max);
+    // removal_height is a world z (simulation.hpp), whatever the gravity.
+    if (region.lo.z < scene.removal_height) {
+      Hazard hz;
+      hz.kind = Hazard::Kind::SpawnBelowRemoval;
+      hz.value = region.lo.z;
+      hz.limit = scene.removal_height;
+      hz.where = idx("parts", i) + ".spawn_min.z, removal_height";
+      hz.message = "parts of " + idx("parts", i) + " can spawn at z = " + fmt(region.lo.z) +
+                   " m, below removal_height = " + fmt(scene.removal_height) +
+                   " m: they are removed as they appear";
+      hz.safe_setting = "removal_height < " + fmt(region.lo.z) + " m";
+      out.push_back(hz);
+    }
+  }
+
+  // --- 6. Settings the engine ignores ---------------------------------------------------------
+  if (!ode && scene.material.restitution > 0) {
+    Hazard hz;
+    hz.kind = Hazard::Kind::IgnoredSetting;
+    hz.value = scene.material.restitution;
+    hz.limit = 0;
+    hz.where = "material.restitution";
+    hz.message = "material.restitution = " + fmt(scene.material.restitution) +
+                 ": the reference solver has no restitution (every impact is inelastic)";
+    hz.safe_setting = "material.restitution = 0, or an ODE method";
+    out.push_back(hz);
+  }
+  return out;
+}
+
+std::string formatHazards(const std::vector<Hazard>& hazards, const std::string& prefix) {
+  std::string text;
+  for (const Hazard& h : hazards) {
+    text += prefix + "warning [" + toString(h.kind) + "] " + h.where + ": " + h.message + "\n";
+    text += prefix + "  safe: " + h.safe_setting + "\n";
+  }
+  return text;
+}
+
+}  // namespace rheofeed::scene

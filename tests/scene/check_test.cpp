@@ -1,0 +1,341 @@
+// SPDX-License-Identifier: MIT
+// The scene check (check.hpp): each hazard fires on a scene built to have it, with numbers
+// recomputed here from mechanics (free fall, semi-implicit Euler travel, masses from densities
+// and edges), and stays quiet on the built-in and demo scenes that run well. The mass-ratio
+// limits are checked against ODE itself: a stack at the table's limit holds, ten times it does
+// not.
+#include "rheofeed/scene/check.hpp"
+
+#include <gtest/gtest.h>
+#include <ode/ode.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "rheofeed/scene/builtin_scenes.hpp"
+#include "rheofeed/scene/scene_io.hpp"
+#include "rheofeed/scene/simulation.hpp"
+
+namespace rheofeed::scene {
+namespace {
+
+constexpr double kG = 9.81;
+// The check's numbers are closed forms of the same inputs: only rounding differs.
+constexpr double kRelative = 1e-9;
+
+Fixture floorBox(double thickness) {
+  Fixture f;
+  f.name = "floor";
+  Fixture::Geom g;
+  g.shape.kind = Shape::Kind::Box;
+  g.shape.size = {1, 1, thickness};
+  g.pose.position = {0, 0, -0.5 * thickness};  // top at z = 0
+  f.geoms.push_back(g);
+  return f;
+}
+
+PartSpec cubes(double edge, double density, const Vec3& lo, const Vec3& hi, int count = 1) {
+  PartSpec p;
+  p.shape = Shape::Kind::Box;
+  for (auto& d : p.size) d.mean = edge;
+  p.density = density;
+  p.spawn_min = lo;
+  p.spawn_max = hi;
+  p.count = count;
+  return p;
+}
+
+std::vector<Hazard> ofKind(const std::vector<Hazard>& all, Hazard::Kind kind) {
+  std::vector<Hazard> out;
+  for (const Hazard& h : all) {
+    if (h.kind == kind) out.push_back(h);
+  }
+  return out;
+}
+
+TEST(SceneCheck, TunnellingFiresForAFallFasterThanHalfTheThicknessPerStep) {
+  Scene s;
+  s.fixtures.push_back(floorBox(0.010));
+  const double edge = 0.005, height = 1.0, h = 0.01;
+  s.parts.push_back(cubes(edge, 1000, {0, 0, 0.2}, {0.1, 0.1, height}, 5));
+  s.solver.time_step = h;
+  const std::vector<Hazard> t =
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::Tunnelling);
+  ASSERT_EQ(t.size(), 1u) << formatHazards(checkScene(s, Method::OdeRheonomic));
+  const double v = std::sqrt(2 * kG * height);  // free fall to the floor top at z = 0
+  EXPECT_NEAR(t[0].value, h * (v + kG * h), kRelative * t[0].value);
+  // Thinnest obstacle: the 5 mm part itself (the floor is 10 mm): centres cross at 5 mm.
+  EXPECT_NEAR(t[0].limit, 0.5 * (edge + edge), kRelative);
+  EXPECT_NE(t[0].where.find("solver.time_step"), std::string::npos);
+  EXPECT_NE(t[0].safe_setting.find("solver.time_step <="), std::string::npos);
+  // The step that moves the falling part exactly 5 mm: h (v + g h) = 5 mm.
+  const double safe_h = (-v + std::sqrt(v * v + 4 * kG * edge)) / (2 * kG);
+  s.solver.time_step = 0.999 * safe_h;
+  EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::Tunnelling).empty());
+  s.solver.time_step = 1.001 * safe_h;
+  EXPECT_EQ(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::Tunnelling).size(), 1u);
+}
+
+TEST(SceneCheck, TunnellingThroughAThinWallAtBeltSpeed) {
+  Scene s;
+  s.fixtures.push_back(floorBox(0.1));
+  s.fixtures[0].law.kind = FeederLaw::Kind::Belt;
+  s.fixtures[0].law.belt_speed = 10;  // m/s
+  Fixture wall;
+  wall.name = "wall";
+  Fixture::Geom g;
+  g.shape.kind = Shape::Kind::Box;
+  g.shape.size = {0.002, 1, 0.05};
+  g.pose.position = {0.4, 0, 0.02};
+  wall.geoms.push_back(g);
+  s.fixtures.push_back(wall);
+  s.parts.push_back(cubes(0.02, 1000, {0, 0, 0.011}, {0, 0, 0.011}));
+  s.solver.time_step = 0.002;
+  const std::vector<Hazard> t =
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::Tunnelling);
+  ASSERT_EQ(t.size(), 1u);
+  EXPECT_NEAR(t[0].value, 0.002 * (10 + kG * 0.002), kRelative);
+  EXPECT_NEAR(t[0].limit, 0.5 * (0.002 + 0.02), kRelative);
+  EXPECT_NE(t[0].where.find("fixtures[1].geoms[0]"), std::string::npos);
+  EXPECT_NE(t[0].message.find("fixtures[0].law.belt.speed"), std::string::npos);
+}
+
+TEST(SceneCheck, FlushWallFiresForAWallStandingOnTheFloorAndNotForASunkOne) {
+  Scene s;
+  s.fixtures.push_back(floorBox(0.02));
+  Fixture wall;
+  wall.name = "wall";
+  Fixture::Geom g;
+  g.shape.kind = Shape::Kind::Box;
+  g.shape.size = {1, 0.01, 0.05};
+  g.pose.position = {0, 0.3, 0.025};  // bottom at z = 0, the floor's top
+  wall.geoms.push_back(g);
+  s.fixtures.push_back(wall);
+  PartSpec plates = cubes(0.02, 7800, {0, 0, 0.01}, {0, 0, 0.01});
+  plates.size[2].mean = 0.0005;  // 0.5 mm plates
+  s.parts.push_back(plates);
+  const std::vector<Hazard> f =
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::FlushWall);
+  ASSERT_EQ(f.size(), 1u) << formatHazards(checkScene(s, Method::OdeRheonomic));
+  EXPECT_NEAR(f[0].value, 0.0, 1e-12);      // the gap: flush
+  EXPECT_NEAR(f[0].limit, -0.0005, 1e-12);  // sunk by at least the thinnest part
+  EXPECT_NE(f[0].where.find("fixtures[1].geoms[0]"), std::string::npos);
+  EXPECT_NE(f[0].safe_setting.find("0.5 mm"), std::string::npos) << f[0].safe_setting;
+  // A 0.3 mm gap under the wall is still a seam a 0.5 mm plate can wedge into.
+  s.fixtures[1].geoms[0].pose.position.z = 0.025 + 0.0003;
+  EXPECT_EQ(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::FlushWall).size(), 1u);
+  // Sunk 1 mm (two plate thicknesses) into the floor: safe.
+  s.fixtures[1].geoms[0].pose.position.z = 0.025 - 0.001;
+  EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::FlushWall).empty());
+  // Beside the floor (no overlap in plan): no seam on the floor.
+  s.fixtures[1].geoms[0].pose.position = {0, 0.505, 0.025};
+  EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::FlushWall).empty());
+}
+
+// A light cube under a heavy one of the same edge on a floor (the geometry of the table in
+// check.cpp): returns the largest penetration (m) in the second second.
+double stackPenetration(double ratio, int iterations, double h, double edge, Method method) {
+  Scene s;
+  s.fixtures.push_back(floorBox(0.1));
+  // drawParts keeps parts spawned at t = 0 apart by their bounding spheres (sqrt(3) edge):
+  // the heavy cube falls 0.8 edge onto the light one.
+  s.parts.push_back(cubes(edge, 1000, {0, 0, edge / 2}, {0, 0, edge / 2}));
+  s.parts.push_back(cubes(edge, 1000 * ratio, {0, 0, 2.3 * edge}, {0, 0, 2.3 * edge}));
+  s.solver.time_step = h;
+  s.solver.iterations = iterations;
+  s.duration = 2;
+  // Quickstep shuffles its rows with ODE's global generator; the boundary moves with it (at
+  // X = 20, k = 20 a stack at R = 3.5 was crushed in 2 of 8 repeats): one fixed seed.
+  dRandSetSeed(1);
+  auto sim = makeSimulation(s, method);
+  double worst = 0;
+  while (sim->time() < 2.0 - 0.5 * h) {
+    sim->step();
+    if (sim->time() < 1.0) continue;
+    const PartState a = sim->part(0), b = sim->part(1);
+    worst = std::max(
+        {worst, -(a.position.z - edge / 2), (a.position.z + edge / 2) - (b.position.z - edge / 2)});
+  }
+  return worst;
+}
+
+TEST(SceneCheck, MassRatioFiresWithTheMassesFromDensitiesAndEdges) {
+  Scene s;
+  s.fixtures.push_back(floorBox(0.1));
+  const double edge = 0.01, h = 0.005;
+  s.parts.push_back(cubes(edge, 1000, {-0.3, -0.3, 0.02}, {0.3, 0.3, 0.05}, 10));
+  s.parts.push_back(cubes(edge, 1e6, {-0.3, -0.3, 0.06}, {0.3, 0.3, 0.09}, 10));
+  s.solver.time_step = h;
+  s.solver.iterations = 50;
+  const std::vector<Hazard> m =
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::MassRatio);
+  ASSERT_EQ(m.size(), 1u) << formatHazards(checkScene(s, Method::OdeRheonomic));
+  const double light = 1000 * edge * edge * edge, heavy = 1e6 * edge * edge * edge;
+  EXPECT_NEAR(m[0].value, heavy / light, kRelative * heavy / light);
+  EXPECT_EQ(m[0].limit, odeQuickstepMassRatioLimit(50, edge, h, kG));
+  EXPECT_NE(m[0].safe_setting.find("ode_quickstep = false"), std::string::npos);
+  // Dantzig (dWorldStep) solves the LCP exactly: no iteration count to run out of.
+  s.solver.ode_quickstep = false;
+  EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::MassRatio).empty());
+  // Masses within the limit: quiet.
+  s.solver.ode_quickstep = true;
+  s.parts[1].density = 1000 * odeQuickstepMassRatioLimit(50, edge, h, kG);
+  EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::MassRatio).empty());
+}
+
+// The table's limits are ODE's behaviour: at the limit the stack holds (penetration below a
+// quarter edge, as measured), at ten times the limit it does not. Three points of the table.
+TEST(SceneCheck, OdeQuickstepHoldsAStackAtTheTableLimitAndNotAtTenTimesIt) {
+  const double edge = 0.01;
+  for (const auto& [x, k] : {std::pair<double, int>{20, 20}, {100, 50}, {500, 100}}) {
+    const double h = std::sqrt(edge / (kG * x));
+    const double limit = odeQuickstepMassRatioLimit(k, edge, h, kG);
+    SCOPED_TRACE("X = " + std::to_string(x) + ", k = " + std::to_string(k) +
+                 ", limit = " + std::to_string(limit));
+    EXPECT_LT(stackPenetration(limit, k, h, edge, Method::OdeRheonomic), edge / 4);
+    EXPECT_GT(stackPenetration(10 * limit, k, h, edge, Method::OdeRheonomic), edge / 4);
+  }
+}
+
+TEST(SceneCheck, ReferenceHoldsAStackAtItsTableLimit) {
+  const double edge = 0.01, x = 100;
+  const int k = 50;
+  const double h = std::sqrt(edge / (kG * x));
+  const double limit = referenceMassRatioLimit(k, edge, h, kG);
+  EXPECT_GT(limit, odeQuickstepMassRatioLimit(k, edge, h, kG));
+  EXPECT_LT(stackPenetration(limit, k, h, edge, Method::ReferenceRheonomic), edge / 4);
+}
+
+// The measurement behind the tables of check.cpp (not a test: prints the boundary).
+//   rheofeed_scene_tests --gtest_also_run_disabled_tests --gtest_filter='*MassRatioProbe*'
+TEST(SceneCheck, DISABLED_MassRatioProbe) {
+  const double ratios[] = {1,   1.5, 2,   3,   5,   7,    10,   15,   20,   30,   50,   70,   100,
+                           150, 200, 300, 500, 700, 1000, 1500, 2000, 3000, 5000, 7000, 10000};
+  for (const Method method : {Method::OdeRheonomic, Method::ReferenceRheonomic}) {
+    for (double edge : {0.002, 0.01, 0.05}) {
+      for (double x : {20.0, 50.0, 100.0, 200.0, 500.0, 2000.0, 8000.0}) {
+        const double h = std::sqrt(edge / (kG * x));
+        for (int k : {10, 20, 50, 100, 200}) {
+          double hold = 0, crush = 0;
+          for (double r : ratios) {
+            if (stackPenetration(r, k, h, edge, method) > edge / 4) {
+              crush = r;
+              break;
+            }
+            hold = r;
+          }
+          std::printf("%s edge=%g X=%g h=%.3g k=%d hold=%g crush=%g\n", toString(method), edge, x,
+                      h, k, hold, crush);
+          std::fflush(stdout);
+        }
+      }
+    }
+  }
+}
+
+TEST(SceneCheck, CoarseFullVibrationStepFires) {
+  Scene s = vibratingTrackScene(0.2e-3, 50);
+  s.solver.time_step = 1.0 / (10 * 50);  // 10 steps per cycle
+  const std::vector<Hazard> c =
+      ofKind(checkScene(s, Method::OdeFullVibration), Hazard::Kind::CoarseVibrationStep);
+  ASSERT_EQ(c.size(), 1u);
+  EXPECT_NEAR(c[0].value, 10, 1e-9);
+  EXPECT_NE(c[0].safe_setting.find("0.001"), std::string::npos) << c[0].safe_setting;
+  // A rheonomic run does not vibrate.
+  EXPECT_TRUE(
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::CoarseVibrationStep).empty());
+}
+
+TEST(SceneCheck, SpawnInsideAFixtureAndBelowTheRemovalHeightFire) {
+  Scene s;
+  s.fixtures.push_back(floorBox(0.02));
+  s.parts.push_back(cubes(0.01, 1000, {0, 0, -0.005}, {0.1, 0.1, 0.05}, 3));
+  std::vector<Hazard> all = checkScene(s, Method::OdeRheonomic);
+  ASSERT_EQ(ofKind(all, Hazard::Kind::SpawnInsideFixture).size(), 1u) << formatHazards(all);
+  s.parts[0].spawn_min.z = 0.006;  // centres above the top: no part can start inside
+  EXPECT_TRUE(
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture).empty());
+  // A tilted floor box: the region just above the untilted top is inside the tilted one.
+  s.fixtures[0].geoms[0].pose = Pose::axisAngle({0, 1, 0}, -0.2, {0, 0, -0.01});
+  EXPECT_EQ(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture).size(),
+            1u);
+  s.fixtures[0].geoms[0].pose = Pose{};
+  s.fixtures[0].geoms[0].pose.position = {0, 0, -0.01};
+  s.removal_height = 0.01;
+  all = checkScene(s, Method::OdeRheonomic);
+  const std::vector<Hazard> r = ofKind(all, Hazard::Kind::SpawnBelowRemoval);
+  ASSERT_EQ(r.size(), 1u) << formatHazards(all);
+  EXPECT_EQ(r[0].value, 0.006);
+}
+
+TEST(SceneCheck, RestitutionIsReportedAsIgnoredByTheReference) {
+  Scene s = beltScene();
+  s.material.restitution = 0.5;
+  EXPECT_EQ(ofKind(checkScene(s, Method::ReferenceRheonomic), Hazard::Kind::IgnoredSetting).size(),
+            1u);
+  EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::IgnoredSetting).empty());
+}
+
+TEST(SceneCheck, FormatNamesKindPathAndSafeSetting) {
+  Hazard h;
+  h.kind = Hazard::Kind::Tunnelling;
+  h.where = "solver.time_step";
+  h.message = "m";
+  h.safe_setting = "solver.time_step <= 0.001 s";
+  EXPECT_EQ(formatHazards({h}, "demo: "),
+            "demo: warning [tunnelling] solver.time_step: m\n"
+            "demo:   safe: solver.time_step <= 0.001 s\n");
+  EXPECT_EQ(formatHazards({}), "");
+}
+
+// Scenes that run well are not flagged. Built-in scenes with their own steps; the demo scenes
+// with the steps their demos use (full vibration: the file's step; rheonomic: the step the
+// file's comment or the demo gives).
+void expectQuiet(const Scene& s, Method m) {
+  const std::vector<Hazard> all = checkScene(s, m);
+  EXPECT_TRUE(all.empty()) << s.name << " " << toString(m) << " h = " << s.solver.time_step << "\n"
+                           << formatHazards(all);
+}
+
+TEST(SceneCheck, BuiltInScenesAreQuiet) {
+  for (const Scene& s :
+       {beltScene(), inclineBeltScene(0.25), turntableScene(), helicalRampScene(1),
+        pileOnBeltScene(), troughScene(40, false), troughScene(40, true), linearTroughScene()}) {
+    for (Method m : {Method::OdeRheonomic, Method::ReferenceRheonomic}) expectQuiet(s, m);
+    if (s.hasVibration()) {
+      for (Method m : {Method::OdeFullVibration, Method::ReferenceFullVibration}) expectQuiet(s, m);
+    }
+  }
+  expectQuiet(vibratingTrackScene(), Method::OdeFullVibration);
+}
+
+TEST(SceneCheck, DemoScenesAreQuietAtTheirSteps) {
+  const std::filesystem::path dir = std::filesystem::path(RHEOFEED_DEMO_DIR) / "scenes";
+  const Scene belt = loadScene(dir / "belt_conveyor.json");
+  expectQuiet(belt, Method::OdeRheonomic);
+  const Scene table = loadScene(dir / "turntable.json");
+  expectQuiet(table, Method::OdeRheonomic);
+  Scene trough = loadScene(dir / "linear_vibratory_trough.json");
+  expectQuiet(trough, Method::OdeFullVibration);
+  // "rheonomic runs can use 0.002" (the file's comment): the check disagrees, see the report:
+  // the free fall of 0.47 m from the hopper to the catch floor (3 m/s, 6.1 mm per step against
+  // 5 mm plates) and the largest / smallest plate (25.4 against a measured 20 at 30
+  // iterations). Both are real by the check's criteria; neither was run to confirm.
+  trough.solver.time_step = 0.002;
+  const std::vector<Hazard> at2ms = checkScene(trough, Method::OdeRheonomic);
+  ASSERT_EQ(at2ms.size(), 2u) << formatHazards(at2ms);
+  EXPECT_EQ(at2ms[0].kind, Hazard::Kind::Tunnelling);
+  EXPECT_EQ(at2ms[1].kind, Hazard::Kind::MassRatio);
+  Scene bowl = loadScene(dir / "bowl_feeder.json");
+  expectQuiet(bowl, Method::OdeFullVibration);
+  bowl.solver.time_step = 0.005;  // bowl_feeder's rheonomic step
+  expectQuiet(bowl, Method::OdeRheonomic);
+  // The bowl's file says that nuts tunnel through its 4 mm ramp at the runner's default 0.01 s.
+  bowl.solver.time_step = 0.01;
+  EXPECT_EQ(ofKind(checkScene(bowl, Method::OdeRheonomic), Hazard::Kind::Tunnelling).size(), 1u);
+}
+
+}  // namespace
+}  // namespace rheofeed::scene
