@@ -24,9 +24,11 @@
 ///    i.e. the initial energy plus, per part, twice the kinetic energy of the fastest surface
 ///    contact it can get (translation plus as much in rotation) and of the push-out;
 ///  - maximum penetration: the deepest part point behind a measured surface (from the part's
-///    pose and shape), for parts whose centre is still in front of it, absolute (m) and relative
-///    to the part's thinnest dimension; a full-vibration floor is taken at its lowest position
-///    during the step;
+///    pose and shape), for parts whose centre is still in front of it (m); and the excess
+///    penetration relative to the part's thinnest dimension, i.e. depth minus what the scene or
+///    a discrete step puts there unavoidably: the part's depth when it spawned, and the landing
+///    overshoot h (approach speed before the step + in full vibration the surface speed). A
+///    full-vibration floor is taken at its lowest position during the step;
 ///  - parts lost, counted once each: removed by the engine (below Scene::removal_height),
 ///    non-finite, centre behind a measured surface by more than the part's size (tunnelled),
 ///    or centre outside the case's bounds box; compared with Simulation::health().partsLost().
@@ -88,7 +90,7 @@ scene::Scene sceneFor(const StabilityCase& c, scene::Method method);
 struct Limits {
   double speed_slack = 1.2;        ///< max speed may reach speed_slack * v_bound
   double energy_slack = 1.1;       ///< max E may reach energy_slack * E_budget
-  double penetration_ratio = 0.2;  ///< penetration / thinnest part dimension
+  double penetration_ratio = 0.2;  ///< excess penetration / thinnest part dimension
 };
 
 /// One run of a case through one method, measured from the part states.
