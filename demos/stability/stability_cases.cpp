@@ -466,7 +466,8 @@ StabilityCase track(const std::string& name, const std::string& covers, double f
   b.scene().material.mu = mu;
   b.scene().duration = 2.0;
   b.kase().fv_steps_per_cycle = steps_per_cycle;
-  b.kase().fv_duration = std::min(1.0, 25000.0 / (frequency * steps_per_cycle));
+  // Full vibration: 1 s, or 50000 steps when fewer (1000 steps per cycle at 50 Hz: 1 s).
+  b.kase().fv_duration = std::min(1.0, 50000.0 / (frequency * steps_per_cycle));
   return b.finish();
 }
 

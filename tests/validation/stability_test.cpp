@@ -13,6 +13,7 @@
 //    removed, non-finite) is reported by Simulation::health().
 #include <gtest/gtest.h>
 
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,10 @@ std::vector<QuickRun> quickRuns() {
     for (scene::Method m : methodsFor(c)) out.push_back({c, m});
   }
   return out;
+}
+
+void PrintTo(const QuickRun& run, std::ostream* os) {
+  *os << run.kase.name << " / " << scene::toString(run.method);
 }
 
 class StabilityMatrix : public testing::TestWithParam<QuickRun> {};
