@@ -120,6 +120,43 @@ TEST(RunHealth, CubeDroppedGentlyOnTheThinFloorLandsAndIsNotCounted) {
   }
 }
 
+// The same throw onto thicker floors: after the step the centre is at z1 = -7.5 mm, inside
+// the floor. Contact then pushes along the axis of least overlap (box-box separating axes): up
+// through the top face (overlap 5 + 7.5 mm) if that is less than down through the bottom face
+// (overlap 5 + thickness - 7.5 mm).
+Scene thickFloorScene(double thickness) {
+  Scene s = thinFloorScene(kStartHeight, kThrowSpeed);
+  s.fixtures[0] = floorBox(1, 1, thickness, 0);
+  return s;
+}
+
+TEST(RunHealth, CubeSunkIntoAThickFloorAndPushedBackIsSunkNotLost) {
+  const double z1 = kStartHeight - kStep * (kThrowSpeed + kGravity * kStep);
+  const double thickness = 0.05;  // up: 12.5 mm, down: 47.5 mm
+  ASSERT_LT(0.5 * kEdge - z1, 0.5 * kEdge + thickness + z1);
+  for (Method m : kRheonomic) {
+    SCOPED_TRACE(toString(m));
+    const std::unique_ptr<Simulation> sim = runFor(thickFloorScene(thickness), m, 100);
+    EXPECT_EQ(sim->health().parts_sunk, 1);
+    EXPECT_EQ(sim->health().partsLost(), 0);
+    EXPECT_TRUE(sim->part(0).active);
+    EXPECT_NEAR(sim->part(0).position.z, 0.5 * kEdge, 1e-3);  // resting on top again
+  }
+}
+
+TEST(RunHealth, CubePushedOutThroughTheFloorsUndersideIsCountedThroughFixture) {
+  const double z1 = kStartHeight - kStep * (kThrowSpeed + kGravity * kStep);
+  const double thickness = 0.012;  // up: 12.5 mm, down: 9.5 mm
+  ASSERT_GT(0.5 * kEdge - z1, 0.5 * kEdge + thickness + z1);
+  for (Method m : kRheonomic) {
+    SCOPED_TRACE(toString(m));
+    const std::unique_ptr<Simulation> sim = runFor(thickFloorScene(thickness), m, 50);
+    EXPECT_EQ(sim->health().parts_through_fixture, 1);
+    EXPECT_EQ(sim->health().parts_sunk, 0);
+    EXPECT_LT(sim->part(0).position.z, -thickness);
+  }
+}
+
 // ---- Falls, bounds, exits -----------------------------------------------------------------
 
 // A frictionless 20 cm square floor (top z = 0); a 2 cm cube on it 5 cm from its +x edge,

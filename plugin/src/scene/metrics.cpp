@@ -257,6 +257,11 @@ std::string healthSummary(const RunHealth& h, int parts) {
     }
     separator = "; ";
   }
+  if (h.parts_sunk > 0) {
+    s << separator << h.parts_sunk << " parts sank into a fixture by more than half their size "
+      << "and came back";
+    separator = "; ";
+  }
   if (h.coulomb_fallback_steps > 0) {
     s << separator << h.coulomb_fallback_steps << " of " << h.steps << " steps used the Coulomb "
       << "fallback (" << 100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps) << " %)";
@@ -316,11 +321,12 @@ std::string summaryJson(const RunMetrics& r) {
   std::snprintf(c, sizeof c,
                 ", \"health\": {\"steps\": %ld, \"parts_exited\": %d, \"parts_lost\": %d, "
                 "\"parts_fell\": %d, \"parts_through_fixture\": %d, \"parts_out_of_bounds\": %d, "
-                "\"parts_nonfinite\": %d, \"parts_too_fast\": %d, \"coulomb_fallback_steps\": %ld, "
+                "\"parts_nonfinite\": %d, \"parts_too_fast\": %d, \"parts_sunk\": %d, "
+                "\"coulomb_fallback_steps\": %ld, "
                 "\"coulomb_fallback_share\": %.6g, \"solver_unconverged_steps\": %ld, "
                 "\"max_part_speed_mps\": %.6g, \"speed_bound_mps\": %.6g, \"ignored_settings\": [",
                 h.steps, h.parts_exited, h.partsLost(), h.parts_fell, h.parts_through_fixture,
-                h.parts_out_of_bounds, h.parts_nonfinite, h.parts_too_fast,
+                h.parts_out_of_bounds, h.parts_nonfinite, h.parts_too_fast, h.parts_sunk,
                 h.coulomb_fallback_steps,
                 h.steps > 0 ? double(h.coulomb_fallback_steps) / h.steps : 0.0,
                 h.solver_unconverged_steps, h.max_part_speed, h.speed_bound);

@@ -65,8 +65,9 @@ class ReferenceSimulation final : public PartSimulation {
     if (report.contacts > 0 && report.solve.status != ccp::Status::Converged) {
       ++health_.solver_unconverged_steps;
       std::ostringstream line;
-      line << "step from t = " << time() << " s: contact solve " << ccp::toString(report.solve.status)
-           << " after " << report.solve.iterations << " iterations (" << report.contacts
+      line << "step from t = " << time() << " s: contact solve "
+           << ccp::toString(report.solve.status) << " after " << report.solve.iterations
+           << " iterations (" << report.contacts
            << " contacts, solver.iterations = " << scene_.solver.iterations
            << ", solver.tolerance = " << scene_.solver.tolerance << ")";
       reportFirst("unconverged step", line.str());

@@ -27,9 +27,15 @@
 // A part's centre never reaches a fixture surface in contact (it stays at least its smallest
 // half-size away, less the penetration). When it moves by more than kTunnelCheckFraction of
 // that half-size in one step, an ODE ray from its old centre to its new one is collided with
-// every fixture geom whose box it overlaps (at the geoms' current poses): a hit means the centre
-// crossed a fixture surface within the step. Slower crossings need a centre already sunk by
-// more than 3/4 of its half-size: a penetration, not a jump through.
+// every fixture geom whose box it overlaps (at the geoms' current poses); slower crossings need
+// a centre already sunk by more than 3/4 of its half-size. If the ray crosses a surface:
+// - and the reverse ray (new to old centre) crosses one elsewhere, the centre went into a
+//   fixture and out again within the step: through (a thin floor jumped over);
+// - else the centre is now inside a fixture (or behind a mesh sheet): the entry point and the
+//   entry surface's outward normal are kept and the part's rays are cast every step until its
+//   centre crosses a surface again: on the outer side of the entry surface's plane is a deep
+//   penetration that recovered (parts_sunk), on its inner side a pass through
+//   (parts_through_fixture); leaving the scene while inside is a pass through too.
 #include "rheofeed/scene/simulation.hpp"
 
 #include <algorithm>
@@ -47,6 +53,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinMargin = 1.0;             // m: smallest margin around the scene's extent
 constexpr double kTunnelCheckFraction = 0.25;  // of the smallest half-size, see above
+// Two crossings along one segment are distinct when they are this far apart (m): far below any
+// part or fixture size, far above the round-off of a ray test over a step.
+constexpr double kCrossingTolerance = 1e-9;
 
 Bounds emptyBounds() {
   return {{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
@@ -303,15 +312,19 @@ void PartSimulation::spawnDue() {
   }
 }
 
-bool PartSimulation::crossesFixture(const Vec3& a, const Vec3& b) {
+double PartSimulation::firstCrossing(const Vec3& a, const Vec3& b, Vec3* normal) {
   const Vec3 d = b - a;
   const double length = norm(d);
-  if (!(length > 0) || fixture_geoms_.empty()) return false;
-  if (!ray_) ray_ = dCreateRay(nullptr, length);
+  if (!(length > 0) || fixture_geoms_.empty()) return kInf;
+  if (!ray_) {
+    ray_ = dCreateRay(nullptr, length);
+    dGeomRaySetClosestHit(ray_, 1);  // meshes: the nearest triangle, not any
+  }
   dGeomRaySetLength(ray_, length);
   dGeomRaySet(ray_, a.x, a.y, a.z, d.x, d.y, d.z);
   dReal ray_box[6], box[6];
   dGeomGetAABB(ray_, ray_box);
+  double first = kInf;
   for (dGeomID g : fixture_geoms_) {
     dGeomGetAABB(g, box);
     if (box[1] < ray_box[0] || box[0] > ray_box[1] || box[3] < ray_box[2] || box[2] > ray_box[3] ||
@@ -319,9 +332,49 @@ bool PartSimulation::crossesFixture(const Vec3& a, const Vec3& b) {
       continue;
     }
     dContactGeom contact;
-    if (dCollide(ray_, g, 1, &contact, sizeof contact) > 0) return true;
+    if (dCollide(ray_, g, 1, &contact, sizeof contact) > 0 && contact.depth < first) {
+      first = contact.depth;
+      if (normal) *normal = {contact.normal[0], contact.normal[1], contact.normal[2]};
+    }
   }
-  return false;
+  return first;
+}
+
+void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const PartState& s) {
+  Track& tr = tracks_[i];
+  const Vec3 to = s.position;
+  const double length = norm(to - from);
+  Vec3 normal;
+  const double forward = firstCrossing(from, to, &normal);
+  if (!(forward <= length)) return;  // no surface crossed
+  const Vec3 u = (1.0 / length) * (to - from);
+  const char* kind = "part through a fixture";
+  if (!tr.inside) {
+    const double backward = firstCrossing(to, from);
+    if (forward + backward < length - kCrossingTolerance) {  // in and out within the step
+      countLoss(i, kind, "passed through a fixture within one step (tunnelled; kept)",
+                health_.parts_through_fixture, s);
+      return;
+    }
+    tr.inside = true;  // the centre is inside a fixture now
+    tr.entry_point = from + forward * u;
+    tr.entry_normal = dot(normal, u) < 0 ? normal : -normal;  // outward: against the motion
+    return;
+  }
+  tr.inside = false;
+  if (dot(to - tr.entry_point, tr.entry_normal) > 0) {  // back out on the side it entered
+    if (!tr.sunk_counted) {
+      tr.sunk_counted = true;
+      ++health_.parts_sunk;
+      std::ostringstream line;
+      line << "part " << i << "'s centre went into a fixture and came back out at t = " << time_
+           << " s, x = " << formatPosition(to) << " (a penetration deeper than half the part)";
+      reportFirst("part sunk into a fixture", line.str());
+    }
+    return;
+  }
+  countLoss(i, kind, "passed through a fixture over several steps (tunnelled; kept)",
+            health_.parts_through_fixture, s);
 }
 
 void PartSimulation::countLoss(std::size_t i, const std::string& kind, const std::string& what,
@@ -358,7 +411,11 @@ void PartSimulation::remove(std::size_t i, PartCheck check, const PartState& sta
     }
     case PartCheck::BelowRemovalHeight:
     case PartCheck::OutOfBounds:
-      if (tr.beyond_exit) {
+      if (tr.inside && !tr.beyond_exit) {  // went into a fixture and out of the scene
+        countLoss(i, "part through a fixture",
+                  "passed through a fixture and left the scene (removed)",
+                  health_.parts_through_fixture, state);
+      } else if (tr.beyond_exit) {
         if (!tr.counted) ++health_.parts_exited;
         tr.counted = true;
       } else if (check == PartCheck::BelowRemovalHeight) {
@@ -394,14 +451,12 @@ void PartSimulation::step() {
       remove(i, check, s, s);
       continue;
     }
-    if (!tr.counted &&
-        norm(s.position - tr.last.position) > kTunnelCheckFraction * tr.min_half_size &&
-        crossesFixture(tr.last.position, s.position)) {
-      countLoss(i, "part through a fixture",
-                "crossed a fixture surface in one step (tunnelled; kept)",
-                health_.parts_through_fixture, s);
-    }
     tr.beyond_exit = tr.beyond_exit || beyondExitPlane(scene_.outputs, s.position);
+    if (!tr.counted && !tr.beyond_exit &&
+        (tr.inside ||
+         norm(s.position - tr.last.position) > kTunnelCheckFraction * tr.min_half_size)) {
+      trackCrossings(i, tr.last.position, s);
+    }
     if (check != PartCheck::Ok) {
       remove(i, check, s, s);
       continue;

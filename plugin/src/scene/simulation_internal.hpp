@@ -63,11 +63,19 @@ class PartSimulation : public Simulation {
     double min_half_size = 0;  // smallest half-size of the part (m)
     double radius = 0;         // bounding radius about the centre of mass (m)
     bool active = true;
-    bool beyond_exit = false;  // has been beyond the exit plane
-    bool counted = false;      // counted in a RunHealth loss already
+    bool beyond_exit = false;   // has been beyond the exit plane
+    bool counted = false;       // counted in a RunHealth loss (or as an exit) already
+    bool sunk_counted = false;  // counted in parts_sunk already
+    // Centre inside a fixture: where it entered (m) and the entry surface's outward normal.
+    bool inside = false;
+    Vec3 entry_point, entry_normal;
   };
-  // Whether the segment a -> b (m) crosses the surface of a fixture geom (ODE ray test).
-  bool crossesFixture(const Vec3& a, const Vec3& b);
+  // Distance (m) from a along the segment a -> b to the first fixture surface it crosses
+  // (ODE ray test at the geoms' current poses); infinity when it crosses none. `normal`
+  // (optional) receives the surface normal there (unit, either orientation).
+  double firstCrossing(const Vec3& a, const Vec3& b, Vec3* normal = nullptr);
+  // The tunnelling test of part i moving from `from` to state s (simulation.cpp).
+  void trackCrossings(std::size_t i, const Vec3& from, const PartState& s);
   // Takes part i out, parked at `park`, and counts it under `check` (unless counted already);
   // `state` is the state that failed the check.
   void remove(std::size_t i, PartCheck check, const PartState& state, const PartState& park);
@@ -82,7 +90,7 @@ class PartSimulation : public Simulation {
   std::vector<Track> tracks_;
   std::unordered_set<dGeomID> fixture_set_;  // lookups only: never iterated
   std::vector<dGeomID> fixture_geoms_;       // in creation order (deterministic iteration)
-  dGeomID ray_ = nullptr;                    // for crossesFixture, in no space
+  dGeomID ray_ = nullptr;                    // for firstCrossing, in no space
   std::vector<std::string> reported_;        // kinds already reported on stderr
   double time_ = 0;
   long steps_ = 0;

@@ -49,10 +49,15 @@ struct RunHealth {
   /// Parts removed below Scene::removal_height without having been beyond the exit plane (fell
   /// off an edge, or over a wall or rim).
   int parts_fell = 0;
-  /// Parts whose centre crossed a fixture surface within one step (tunnelling: through a floor
-  /// or a wall, or out of a fixture it was spawned in). They stay in the simulation; each part
-  /// is counted once.
+  /// Parts whose centre passed through a fixture (tunnelling: through a floor or a wall): within
+  /// one step, or into it and out on another side, or into it and then out of the scene. They
+  /// stay in the simulation until they leave it; each part is counted once. Parts beyond the
+  /// exit plane are not checked (they are out of the measurement).
   int parts_through_fixture = 0;
+  /// Parts whose centre went into a fixture (a penetration deeper than half the part) and came
+  /// back out on the side it entered: not lost, but the contact did not hold them. Counted once
+  /// per part; not part of partsLost().
+  int parts_sunk = 0;
   /// Parts removed because they left the scene bounds (SceneLimits::bounds) sideways or up.
   int parts_out_of_bounds = 0;
   /// Parts whose state (position, velocity, angular velocity, orientation) became NaN or
@@ -83,8 +88,8 @@ struct RunHealth {
   }
   /// Whether anything was lost, not trusted or ignored.
   bool anything() const {
-    return partsLost() > 0 || coulomb_fallback_steps > 0 || solver_unconverged_steps > 0 ||
-           !ignored_settings.empty();
+    return partsLost() > 0 || parts_sunk > 0 || coulomb_fallback_steps > 0 ||
+           solver_unconverged_steps > 0 || !ignored_settings.empty();
   }
 };
 
