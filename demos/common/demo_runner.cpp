@@ -86,8 +86,8 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
     const std::string unit = scene.outputs.angular_drift ? "rad/s" : "m/s";
     std::printf(
         "| method | h (s) | parts | mean drift (%s) | 95 %% CI | vertical disp. (m) | "
-        "throughput (parts/s) | CPU (s) | real-time factor "
-        "|\n|---|---|---|---|---|---|---|---|---|\n",
+        "throughput (parts/s) | CPU (s) | real-time factor | lost parts | Coulomb fallback "
+        "steps |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
         unit.c_str());
     std::vector<std::pair<std::string, std::string>> blocks;
     for (Method m : chosen) {
@@ -103,9 +103,13 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
       const RunMetrics r = measureRun(s, m, stderrProgress(name + " " + toString(m)));
       writeRunOutputs(r, out_dir, toString(m));
       blocks.emplace_back(toString(m), seriesCsv(r));
-      std::printf("| %s | %.3g | %d | %.5f | %.5f | %.4f | %.2f | %.2f | %.4f |\n", toString(m),
-                  r.time_step, r.parts, r.mean_drift, r.mean_drift_ci95, r.vertical_displacement,
-                  r.throughput, r.cpu_seconds, r.real_time_factor);
+      // Lost parts and fallback steps (RunHealth): the kinds are in the JSON output and the
+      // stderr summary of measureRun.
+      const RunHealth& h = r.health;
+      std::printf("| %s | %.3g | %d | %.5f | %.5f | %.4f | %.2f | %.2f | %.4f | %d | %.1f %% |\n",
+                  toString(m), r.time_step, r.parts, r.mean_drift, r.mean_drift_ci95,
+                  r.vertical_displacement, r.throughput, r.cpu_seconds, r.real_time_factor,
+                  h.partsLost(), 100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps));
     }
     if (blocks.size() > 1) {  // one plot with every method's drift
       std::string gp =

@@ -87,7 +87,7 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
   std::vector<Track> tracks;
   int exited_total = 0, exited_after_warmup = 0;
 
-  auto crossed = [&](const Vec3& x) { return dot(x - out.exit_point, out.exit_normal) >= 0; };
+  auto crossed = [&](const Vec3& x) { return beyondExitPlane(out, x); };
   // Drift coordinate progress of a part between two observations: along d, or the unwrapped
   // angle about the axis.
   const bool angular = out.angular_drift;
@@ -156,6 +156,12 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
       s.ci95 = ci95(v);
       s.mean_height = active ? z / active : 0;
       s.exited = exited_total;
+      const RunHealth& health = sim->health();
+      s.fell = health.parts_fell;
+      s.through_fixture = health.parts_through_fixture;
+      s.out_of_bounds = health.parts_out_of_bounds;
+      s.nonfinite = health.parts_nonfinite;
+      s.too_fast = health.parts_too_fast;
       m.series.push_back(s);
     }
   };
@@ -194,7 +200,12 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
   m.vertical_displacement = m.parts ? dz / m.parts : 0;
   const double window = m.simulated_seconds - out.warmup;
   m.throughput = window > 0 ? exited_after_warmup / window : 0;
+  m.health = sim->health();
   if (progress) progress(1.0);
+  if (m.health.anything()) {
+    std::fprintf(stderr, "rheofeed: %s, %s: %s\n", scene.name.c_str(), toString(method),
+                 healthSummary(m.health, m.parts).c_str());
+  }
   return m;
 }
 
@@ -211,28 +222,119 @@ Progress stderrProgress(const std::string& label) {
 
 std::string seriesCsv(const RunMetrics& run) {
   std::ostringstream s;
-  s << "time_s,parts,mean_velocity_mps,ci95_mps,mean_height_m,exited\n";
-  char line[160];
+  s << "time_s,parts,mean_velocity_mps,ci95_mps,mean_height_m,exited,lost_fell,"
+       "lost_through_fixture,lost_out_of_bounds,lost_nonfinite,lost_too_fast\n";
+  char line[256];
   for (const DriftSample& d : run.series) {
-    std::snprintf(line, sizeof line, "%.6f,%d,%.8g,%.8g,%.8g,%d\n", d.time, d.parts,
-                  d.mean_velocity, d.ci95, d.mean_height, d.exited);
+    std::snprintf(line, sizeof line, "%.6f,%d,%.8g,%.8g,%.8g,%d,%d,%d,%d,%d,%d\n", d.time, d.parts,
+                  d.mean_velocity, d.ci95, d.mean_height, d.exited, d.fell, d.through_fixture,
+                  d.out_of_bounds, d.nonfinite, d.too_fast);
     s << line;
   }
   return s.str();
 }
 
+std::string healthSummary(const RunHealth& h, int parts) {
+  if (!h.anything()) return "nothing lost";
+  std::ostringstream s;
+  const char* separator = "";
+  if (h.partsLost() > 0) {
+    s << h.partsLost() << " of " << parts << " parts lost (";
+    const std::pair<const char*, int> kinds[] = {{"fell", h.parts_fell},
+                                                 {"through a fixture", h.parts_through_fixture},
+                                                 {"out of bounds", h.parts_out_of_bounds},
+                                                 {"non-finite", h.parts_nonfinite},
+                                                 {"too fast", h.parts_too_fast}};
+    const char* comma = "";
+    for (const auto& [name, count] : kinds) {
+      if (count == 0) continue;
+      s << comma << name << " " << count;
+      comma = ", ";
+    }
+    s << ")";
+    if (h.parts_too_fast > 0) {
+      s << ", max speed " << h.max_part_speed << " m/s (bound " << h.speed_bound << " m/s)";
+    }
+    separator = "; ";
+  }
+  if (h.parts_sunk > 0) {
+    s << separator << h.parts_sunk << " parts sank into a fixture by more than half their size "
+      << "and came back";
+    separator = "; ";
+  }
+  if (h.coulomb_fallback_steps > 0) {
+    s << separator << h.coulomb_fallback_steps << " of " << h.steps << " steps used the Coulomb "
+      << "fallback (" << 100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps) << " %)";
+    separator = "; ";
+  }
+  if (h.solver_unconverged_steps > 0) {
+    s << separator << h.solver_unconverged_steps << " of " << h.steps
+      << " steps with an unconverged contact solve";
+    separator = "; ";
+  }
+  if (!h.ignored_settings.empty()) {
+    s << separator << h.ignored_settings.size() << " ignored setting"
+      << (h.ignored_settings.size() > 1 ? "s" : "") << " (";
+    for (std::size_t k = 0; k < h.ignored_settings.size(); ++k) {
+      const std::string& line = h.ignored_settings[k];
+      s << (k ? ", " : "") << line.substr(0, line.find(" ="));
+    }
+    s << ")";
+  }
+  return s.str();
+}
+
+namespace {
+
+// A JSON string literal.
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char esc[8];
+      std::snprintf(esc, sizeof esc, "\\u%04x", static_cast<unsigned>(c));
+      out += esc;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
 std::string summaryJson(const RunMetrics& r) {
   char b[768];
   std::snprintf(b, sizeof b,
-                "{\"scene\": \"%s\", \"method\": \"%s\", \"time_step_s\": %.8g, \"parts\": %d, "
+                ", \"method\": \"%s\", \"time_step_s\": %.8g, \"parts\": %d, "
                 "\"drift_unit\": \"%s\", \"mean_drift\": %.8g, \"mean_drift_ci95\": %.8g, "
                 "\"vertical_displacement_m\": %.8g, \"throughput_parts_per_s\": %.8g, "
-                "\"cpu_seconds\": %.6g, \"simulated_seconds\": %.6g, \"real_time_factor\": %.6g}",
-                r.scene.c_str(), toString(r.method), r.time_step, r.parts,
-                r.angular ? "rad/s" : "m/s", r.mean_drift, r.mean_drift_ci95,
-                r.vertical_displacement, r.throughput, r.cpu_seconds, r.simulated_seconds,
-                r.real_time_factor);
-  return b;
+                "\"cpu_seconds\": %.6g, \"simulated_seconds\": %.6g, \"real_time_factor\": %.6g",
+                toString(r.method), r.time_step, r.parts, r.angular ? "rad/s" : "m/s", r.mean_drift,
+                r.mean_drift_ci95, r.vertical_displacement, r.throughput, r.cpu_seconds,
+                r.simulated_seconds, r.real_time_factor);
+  const RunHealth& h = r.health;
+  char c[768];
+  std::snprintf(c, sizeof c,
+                ", \"health\": {\"steps\": %ld, \"parts_exited\": %d, \"parts_lost\": %d, "
+                "\"parts_fell\": %d, \"parts_through_fixture\": %d, \"parts_out_of_bounds\": %d, "
+                "\"parts_nonfinite\": %d, \"parts_too_fast\": %d, \"parts_sunk\": %d, "
+                "\"coulomb_fallback_steps\": %ld, "
+                "\"coulomb_fallback_share\": %.6g, \"solver_unconverged_steps\": %ld, "
+                "\"max_part_speed_mps\": %.6g, \"speed_bound_mps\": %.6g, \"ignored_settings\": [",
+                h.steps, h.parts_exited, h.partsLost(), h.parts_fell, h.parts_through_fixture,
+                h.parts_out_of_bounds, h.parts_nonfinite, h.parts_too_fast, h.parts_sunk,
+                h.coulomb_fallback_steps,
+                h.steps > 0 ? double(h.coulomb_fallback_steps) / h.steps : 0.0,
+                h.solver_unconverged_steps, h.max_part_speed, h.speed_bound);
+  std::string json = "{\"scene\": " + quoted(r.scene) + b + c;
+  for (std::size_t k = 0; k < h.ignored_settings.size(); ++k) {
+    json += (k ? ", " : "") + quoted(h.ignored_settings[k]);
+  }
+  return json + "]}}";
 }
 
 std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::string& folder,

@@ -2,12 +2,17 @@
 // A scene run in ODE: stationary feeders driven by the plugin (rheonomic), or feeders on
 // kinematic bodies that really vibrate (full vibration; NOTES section 2 and 4: each step the
 // body is put on its law at t and given the secant velocity to its pose at t + h).
+//
+// Determinism: quickstep reorders its constraint rows at random with ODE's process-wide
+// generator (dRand). Each simulation keeps its own generator state, seeded from Scene::seed,
+// and swaps it in around its collide + step only (simulation.hpp, makeSimulation).
 #include <ode/ode.h>
 
 #include <cmath>
+#include <cstdint>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
-#include <unordered_set>
 
 #include "geom_factory.hpp"
 #include "rheofeed/contact_collider.hpp"
@@ -71,6 +76,8 @@ class OdeSimulation final : public PartSimulation {
       }
       return true;
     });
+    random_state_ = randomSeed(scene.seed);
+    listIgnoredSettings();
     spawnDue();
   }
 
@@ -84,12 +91,16 @@ class OdeSimulation final : public PartSimulation {
   void advance(double h) override {
     const double t = time();
     for (const auto& [body, vibration] : vibrating_) driveKinematic(body, vibration, t, h);
-    collider_->collide(space_, t);
+    const unsigned long outside = dRandGetSeed();  // the application's generator state
+    dRandSetSeed(random_state_);
+    collider_->collide(space_, t, h);  // laws frozen on [t, t + h] (secant surface velocity)
     if (scene_.solver.ode_quickstep) {
       dWorldQuickStep(world_, h);
     } else {
       dWorldStep(world_, h);
     }
+    random_state_ = dRandGetSeed();
+    dRandSetSeed(outside);
   }
 
   PartState partState(int i) const override {
@@ -105,8 +116,18 @@ class OdeSimulation final : public PartSimulation {
     return s;
   }
 
-  void removePart(int i) override {
+  // The body is parked at `last` (finite) with no velocity, so that no NaN reaches ODE again.
+  void removePart(int i, const PartState& last) override {
     dBodyID b = parts_.at(static_cast<std::size_t>(i));
+    dBodySetPosition(b, last.position.x, last.position.y, last.position.z);
+    dMatrix3 r;
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 3; ++col) r[4 * row + col] = last.rotation[3 * row + col];
+      r[4 * row + 3] = 0;
+    }
+    dBodySetRotation(b, r);
+    dBodySetLinearVel(b, 0, 0, 0);
+    dBodySetAngularVel(b, 0, 0, 0);
     dBodyDisable(b);
     dGeomDisable(dBodyGetFirstGeom(b));
   }
@@ -117,6 +138,36 @@ class OdeSimulation final : public PartSimulation {
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) r[4 * i + j] = p.rotation[3 * i + j];
       r[4 * i + 3] = 0;
+    }
+  }
+
+  // ODE's generator is 32 bits wide: the scene seed mixed (splitmix64) and cut to 32 bits.
+  static unsigned long randomSeed(std::uint64_t seed) {
+    std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return static_cast<unsigned long>((z ^ (z >> 31)) & 0xffffffffULL);
+  }
+
+  // Settings of the scene ODE does not read, when they differ from their defaults.
+  void listIgnoredSettings() {
+    const SolverSettings defaults;
+    const SolverSettings& s = scene_.solver;
+    auto ignored = [this](const char* name, const auto& value, const char* why) {
+      std::ostringstream line;
+      line << std::boolalpha << "solver." << name << " = " << value << ": ignored by ODE (" << why
+           << ")";
+      ignoreSetting(line.str());
+    };
+    if (s.coulomb_iterations != defaults.coulomb_iterations) {
+      ignored("coulomb_iterations", s.coulomb_iterations, "reference solver only");
+    }
+    if (s.tolerance != defaults.tolerance) {
+      ignored("tolerance", s.tolerance, "reference solver only; quickstep runs its iterations");
+    }
+    if (s.apgd != defaults.apgd) ignored("apgd", s.apgd, "reference solver only");
+    if (!s.ode_quickstep && s.iterations != defaults.iterations) {
+      ignored("iterations", s.iterations, "ode_quickstep = false: dWorldStep is a direct solver");
     }
   }
 
@@ -172,6 +223,7 @@ class OdeSimulation final : public PartSimulation {
   std::unique_ptr<ContactCollider> collider_;
   std::vector<std::pair<dBodyID, Vibration>> vibrating_;
   std::vector<dBodyID> parts_;
+  unsigned long random_state_ = 0;  // this simulation's state of ODE's generator
 };
 
 }  // namespace

@@ -2,7 +2,7 @@
 // A scene run in the reference world (rheofeed::reference::World, cone complementarity).
 #include <algorithm>
 #include <memory>
-#include <unordered_set>
+#include <sstream>
 
 #include "geom_factory.hpp"
 #include "rheofeed/reference/world.hpp"
@@ -47,12 +47,37 @@ class ReferenceSimulation final : public PartSimulation {
         addFixtureGeom(geom);
       }
     }
+    listIgnoredSettings();
     spawnDue();
   }
 
-  void advance(double h) override { world_->step(h); }
+  // Counts the steps whose contact solve cannot be trusted fully (RunHealth).
+  void advance(double h) override {
+    const reference::StepReport report = world_->step(h);
+    if (report.coulomb_fallback) {
+      ++health_.coulomb_fallback_steps;
+      std::ostringstream line;
+      line << "step from t = " << time() << " s: the true-Coulomb fixed point did not settle in "
+           << scene_.solver.coulomb_iterations << " iterations (" << report.contacts
+           << " contacts); the step used the relaxed CCP";
+      reportFirst("Coulomb fallback step", line.str());
+    }
+    if (report.contacts > 0 && report.solve.status != ccp::Status::Converged) {
+      ++health_.solver_unconverged_steps;
+      std::ostringstream line;
+      line << "step from t = " << time() << " s: contact solve "
+           << ccp::toString(report.solve.status) << " after " << report.solve.iterations
+           << " iterations (" << report.contacts
+           << " contacts, solver.iterations = " << scene_.solver.iterations
+           << ", solver.tolerance = " << scene_.solver.tolerance << ")";
+      reportFirst("unconverged step", line.str());
+    }
+  }
 
-  void removePart(int i) override { world_->disableBody(parts_.at(static_cast<std::size_t>(i))); }
+  // The world keeps the body's own state (it cannot be set); PartSimulation reports `last`.
+  void removePart(int i, const PartState&) override {
+    world_->disableBody(parts_.at(static_cast<std::size_t>(i)));
+  }
 
   PartState partState(int i) const override {
     const reference::BodyState& b = world_->state(parts_.at(static_cast<std::size_t>(i)));
@@ -89,6 +114,24 @@ class ReferenceSimulation final : public PartSimulation {
       totals.impulse = totals.impulse + impulse;
     }
     return totals;
+  }
+
+  // Settings of the scene the reference world does not read, when they differ from their
+  // defaults.
+  void listIgnoredSettings() {
+    if (!scene_.solver.ode_quickstep) {
+      ignoreSetting(
+          "solver.ode_quickstep = false: ignored by the reference solver (ODE's stepper choice)");
+    }
+    // ---- Restitution: ignored by the reference world until it implements Newton's impact
+    // law (issue 7, item 3). Delete this block when reference::Settings gains restitution. ----
+    if (scene_.material.restitution > 0) {
+      std::ostringstream line;
+      line << "material.restitution = " << scene_.material.restitution
+           << ": ignored by the reference solver (its impacts are perfectly plastic)";
+      ignoreSetting(line.str());
+    }
+    // ---- end of the restitution block ----
   }
 
   TriMeshStore meshes_;  // declared before world_: destroyed after the world's space and geoms

@@ -1,35 +1,434 @@
 // SPDX-License-Identifier: MIT
+// The part bookkeeping both engines share, and the checks that keep a run from failing
+// silently (issue 7).
+//
+// ## Scene limits (sceneLimits)
+// The extent of a scene is the union of its fixtures' bounding boxes at rest (plane geoms,
+// unbounded, excluded) and its spawn regions. A part can move no faster than what it was given
+// and what the scene can give it:
+//   v_phys = v_initial + v_fall + 2 v_surface + v_correct
+// with v_initial the fastest initial velocity, v_fall = sqrt(2 |g| (z_top - removal_height)) the
+// free-fall speed from the highest point of the extent to the removal height (energy), v_surface
+// the fastest feeder surface point (a belt's speed; a twist's |v| + |w| R, R the farthest
+// distance from its origin to the fixture's box; a vibration's peak velocity 2 pi f (A + theta R)
+// and, in rheonomic runs, its calibrated drift twist), counted twice because an impact on a
+// surface moving at V changes the relative velocity by up to (1 + e) V <= 2 V, and v_correct the
+// contact push-out speed cap (SolverSettings::max_correcting_velocity). A part above
+//   kSpeedBoundFactor v_phys + kSpeedBoundMargin   (2 v_phys + 1 m/s)
+// is an energy blow-up: the factor 2 leaves room for one elastic transfer from a heavy part to
+// a light one (which leaves at up to twice the heavy part's speed), the margin for scenes at
+// rest. The speed of a part is that of its fastest point, |v| + |w| r (r its bounding radius).
+// The scene bounds are the extent grown by a margin: the larger of 1 m, the extent's largest
+// edge and the distance a part thrown sideways at the surface, initial and push-out speeds
+// covers while it falls from z_top to the removal height; upwards at least the height a part at
+// v_phys can climb (v_phys^2 / 2 |g|). Downwards Scene::removal_height takes parts out.
+//
+// ## Tunnelling
+// A part's centre never reaches a fixture surface in contact (it stays at least its smallest
+// half-size away, less the penetration). When it moves by more than kTunnelCheckFraction of
+// that half-size in one step, an ODE ray from its old centre to its new one is collided with
+// every fixture geom whose box it overlaps (at the geoms' current poses); slower crossings need
+// a centre already sunk by more than 3/4 of its half-size. If the ray crosses a surface:
+// - and the reverse ray (new to old centre) crosses one elsewhere, the centre went into a
+//   fixture and out again within the step: through (a thin floor jumped over);
+// - else the centre is now inside a fixture (or behind a mesh sheet): the entry point and the
+//   entry surface's outward normal are kept and the part's rays are cast every step until its
+//   centre crosses a surface again: on the outer side of the entry surface's plane is a deep
+//   penetration that recovered (parts_sunk), on its inner side a pass through
+//   (parts_through_fixture); leaving the scene while inside is a pass through too.
 #include "rheofeed/scene/simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <sstream>
-#include <stdexcept>
 
 #include "simulation_internal.hpp"
 
 namespace rheofeed::scene {
+namespace {
 
-void checkPart(int index, const Vec3& x, Method method, double time) {
-  constexpr double kSceneRadius = 1e4;  // m: nothing in a feeder scene gets this far
-  if (isFinite(x) && std::abs(x.x) < kSceneRadius && std::abs(x.y) < kSceneRadius &&
-      std::abs(x.z) < kSceneRadius) {
-    return;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kMinMargin = 1.0;             // m: smallest margin around the scene's extent
+constexpr double kTunnelCheckFraction = 0.25;  // of the smallest half-size, see above
+// Two crossings along one segment are distinct when they are this far apart (m): far below any
+// part or fixture size, far above the round-off of a ray test over a step.
+constexpr double kCrossingTolerance = 1e-9;
+
+Bounds emptyBounds() {
+  return {{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
+}
+bool isEmpty(const Bounds& b) {
+  return !(b.min.x <= b.max.x);
+}
+
+void grow(Bounds& b, const Vec3& x) {
+  b.min = {std::min(b.min.x, x.x), std::min(b.min.y, x.y), std::min(b.min.z, x.z)};
+  b.max = {std::max(b.max.x, x.x), std::max(b.max.y, x.y), std::max(b.max.z, x.z)};
+}
+void grow(Bounds& b, const Bounds& other) {
+  if (isEmpty(other)) return;
+  grow(b, other.min);
+  grow(b, other.max);
+}
+
+// Bounding box of a fixture geom at its pose (empty for a plane, or a mesh not loaded).
+Bounds geomBounds(const Fixture::Geom& g) {
+  Bounds b = emptyBounds();
+  const double* r = g.pose.rotation;
+  const Shape& s = g.shape;
+  Vec3 half;
+  const Vec3 axis{r[2], r[5], r[8]};  // local z in the world (cylinders, capsules)
+  auto acrossAxis = [](double a) { return std::sqrt(std::max(0.0, 1 - a * a)); };
+  switch (s.kind) {
+    case Shape::Kind::Plane:
+      return b;
+    case Shape::Kind::Mesh:
+      if (!s.mesh_data) return b;
+      for (std::size_t k = 0; k + 2 < s.mesh_data->vertices.size(); k += 3) {
+        const double* v = &s.mesh_data->vertices[k];
+        grow(b, g.pose.transform({v[0], v[1], v[2]}));
+      }
+      return b;
+    case Shape::Kind::Box:
+      half = {
+          0.5 * (std::abs(r[0]) * s.size.x + std::abs(r[1]) * s.size.y + std::abs(r[2]) * s.size.z),
+          0.5 * (std::abs(r[3]) * s.size.x + std::abs(r[4]) * s.size.y + std::abs(r[5]) * s.size.z),
+          0.5 *
+              (std::abs(r[6]) * s.size.x + std::abs(r[7]) * s.size.y + std::abs(r[8]) * s.size.z)};
+      break;
+    case Shape::Kind::Sphere:
+      half = {s.radius, s.radius, s.radius};
+      break;
+    case Shape::Kind::Cylinder:
+      half = {0.5 * s.length * std::abs(axis.x) + s.radius * acrossAxis(axis.x),
+              0.5 * s.length * std::abs(axis.y) + s.radius * acrossAxis(axis.y),
+              0.5 * s.length * std::abs(axis.z) + s.radius * acrossAxis(axis.z)};
+      break;
+    case Shape::Kind::Capsule:
+      half = {0.5 * s.length * std::abs(axis.x) + s.radius,
+              0.5 * s.length * std::abs(axis.y) + s.radius,
+              0.5 * s.length * std::abs(axis.z) + s.radius};
+      break;
   }
-  std::ostringstream out;
-  out << toString(method) << ": part " << index << " is at (" << x.x << ", " << x.y << ", " << x.z
-      << ") m at t = " << time
-      << " s: the step is unstable (reduce solver.time_step, raise solver.iterations, or check "
-         "for parts spawned inside fixtures)";
-  throw std::runtime_error(out.str());
+  grow(b, g.pose.position - half);
+  grow(b, g.pose.position + half);
+  return b;
+}
+
+// Farthest distance from `o` to a point of the box b (m).
+double farthest(const Bounds& b, const Vec3& o) {
+  const Vec3 d{std::max(std::abs(b.min.x - o.x), std::abs(b.max.x - o.x)),
+               std::max(std::abs(b.min.y - o.y), std::abs(b.max.y - o.y)),
+               std::max(std::abs(b.min.z - o.z), std::abs(b.max.z - o.z))};
+  return norm(d);
+}
+
+double twistSpeed(const Twist& t, const Bounds& b) {
+  return norm(t.linear) + norm(t.angular) * farthest(b, t.origin);
+}
+
+// Fastest surface point of a fixture (m/s) within the box b.
+double surfaceSpeed(const FeederLaw& law, const Bounds& b) {
+  switch (law.kind) {
+    case FeederLaw::Kind::None:
+      return 0;
+    case FeederLaw::Kind::Drift:
+      return twistSpeed(law.drift, b);
+    case FeederLaw::Kind::Belt:
+      return std::abs(law.belt_speed);
+    case FeederLaw::Kind::Vibration: {
+      const Vibration& v = law.vibration;
+      const double vibrating =
+          2 * kPi * v.frequency *
+          (std::abs(v.amplitude) + std::abs(v.torsion_amplitude) * farthest(b, v.axis_origin));
+      return std::max(vibrating,
+                      law.has_calibrated_drift ? twistSpeed(law.calibrated_drift, b) : 0.0);
+    }
+  }
+  return 0;
+}
+
+// Smallest half-size (m) and bounding radius about the centre of mass (m) of a part.
+void partSizes(const Shape& s, double& min_half, double& radius) {
+  switch (s.kind) {
+    case Shape::Kind::Box:
+      min_half = 0.5 * std::min({s.size.x, s.size.y, s.size.z});
+      radius = 0.5 * norm(s.size);
+      return;
+    case Shape::Kind::Sphere:
+      min_half = radius = s.radius;
+      return;
+    case Shape::Kind::Cylinder:
+      min_half = std::min(s.radius, 0.5 * s.length);
+      radius = std::hypot(s.radius, 0.5 * s.length);
+      return;
+    case Shape::Kind::Capsule:
+      min_half = s.radius;
+      radius = s.radius + 0.5 * s.length;
+      return;
+    case Shape::Kind::Mesh: {
+      Bounds b = emptyBounds();
+      radius = 0;
+      if (s.mesh_data) {
+        for (std::size_t k = 0; k + 2 < s.mesh_data->vertices.size(); k += 3) {
+          const double* v = &s.mesh_data->vertices[k];
+          grow(b, Vec3{v[0], v[1], v[2]});
+          radius = std::max(radius, norm(Vec3{v[0], v[1], v[2]}));
+        }
+      }
+      const Vec3 e = b.max - b.min;
+      min_half = isEmpty(b) ? 0 : 0.5 * std::min({e.x, e.y, e.z});
+      return;
+    }
+    case Shape::Kind::Plane:
+      break;
+  }
+  min_half = radius = 0;
+}
+
+std::string formatPosition(const Vec3& x) {
+  char b[96];
+  std::snprintf(b, sizeof b, "(%.6g, %.6g, %.6g) m", x.x, x.y, x.z);
+  return b;
+}
+
+}  // namespace
+
+SceneLimits sceneLimits(const Scene& scene) {
+  SceneLimits l;
+  l.removal_height = scene.removal_height;
+  std::vector<Bounds> fixture_bounds;
+  Bounds extent = emptyBounds();
+  for (const Fixture& f : scene.fixtures) {
+    Bounds b = emptyBounds();
+    for (const Fixture::Geom& g : f.geoms) grow(b, geomBounds(g));
+    fixture_bounds.push_back(b);
+    grow(extent, b);
+  }
+  for (const PartSpec& p : scene.parts) {
+    grow(extent, p.spawn_min);
+    grow(extent, p.spawn_max);
+    l.initial_speed = std::max(l.initial_speed, norm(p.initial_velocity));
+  }
+  if (isEmpty(extent)) grow(extent, Vec3{});
+  l.extent = extent;
+  for (std::size_t k = 0; k < scene.fixtures.size(); ++k) {
+    // A fixture of planes only is bounded by the scene's extent.
+    const Bounds& b = isEmpty(fixture_bounds[k]) ? extent : fixture_bounds[k];
+    l.surface_speed = std::max(l.surface_speed, surfaceSpeed(scene.fixtures[k].law, b));
+  }
+  const double g = norm(scene.gravity);
+  const double drop = std::max(0.0, extent.max.z - scene.removal_height);
+  l.fall_speed = std::sqrt(2 * g * drop);
+  l.correcting_speed = scene.solver.max_correcting_velocity;
+  l.physical_speed = l.initial_speed + l.fall_speed + 2 * l.surface_speed + l.correcting_speed;
+  l.speed_bound = kSpeedBoundFactor * l.physical_speed + kSpeedBoundMargin;
+
+  const Vec3 edge = extent.max - extent.min;
+  double margin = std::max({kMinMargin, edge.x, edge.y, edge.z});
+  double climb = margin;
+  if (g > 0) {
+    const double fall_time = std::sqrt(2 * drop / g);
+    margin = std::max(margin, (l.surface_speed + l.initial_speed + l.correcting_speed) * fall_time);
+    climb = std::max(margin, l.physical_speed * l.physical_speed / (2 * g));
+  }
+  l.margin = margin;
+  l.bounds.min = {extent.min.x - margin, extent.min.y - margin, -kInf};
+  l.bounds.max = {extent.max.x + margin, extent.max.y + margin, extent.max.z + climb};
+  return l;
+}
+
+bool beyondExitPlane(const Outputs& outputs, const Vec3& x) {
+  return outputs.exit_plane && dot(x - outputs.exit_point, outputs.exit_normal) >= 0;
+}
+
+const char* toString(PartCheck check) {
+  switch (check) {
+    case PartCheck::Ok:
+      return "ok";
+    case PartCheck::NonFinite:
+      return "non-finite";
+    case PartCheck::TooFast:
+      return "too fast";
+    case PartCheck::BelowRemovalHeight:
+      return "below the removal height";
+    case PartCheck::OutOfBounds:
+      return "out of bounds";
+  }
+  return "?";
+}
+
+PartCheck checkPartState(const PartState& s, const SceneLimits& limits, double radius) {
+  bool finite = isFinite(s.position) && isFinite(s.velocity) && isFinite(s.angular_velocity);
+  for (double r : s.rotation) finite = finite && std::isfinite(r);
+  if (!finite) return PartCheck::NonFinite;
+  if (!(partSpeed(s, radius) <= limits.speed_bound)) return PartCheck::TooFast;
+  if (s.position.z < limits.removal_height) return PartCheck::BelowRemovalHeight;
+  if (!limits.bounds.contains(s.position)) return PartCheck::OutOfBounds;
+  return PartCheck::Ok;
+}
+
+double partSpeed(const PartState& s, double radius) {
+  return norm(s.velocity) + norm(s.angular_velocity) * radius;
 }
 
 PartSimulation::PartSimulation(const Scene& scene, Method method)
-    : scene_(scene), method_(method), instances_(drawParts(scene)) {}
+    : scene_(scene), method_(method), instances_(drawParts(scene)), limits_(sceneLimits(scene)) {
+  health_.speed_bound = limits_.speed_bound;
+}
+
+PartSimulation::~PartSimulation() {
+  if (ray_) dGeomDestroy(ray_);
+}
+
+void PartSimulation::addFixtureGeom(dGeomID geom) {
+  if (fixture_set_.insert(geom).second) fixture_geoms_.push_back(geom);
+}
+
+void PartSimulation::ignoreSetting(const std::string& message) {
+  health_.ignored_settings.push_back(message);
+  std::fprintf(stderr, "rheofeed: %s: %s\n", toString(method_), message.c_str());
+}
+
+void PartSimulation::reportFirst(const std::string& kind, const std::string& line) {
+  if (std::find(reported_.begin(), reported_.end(), kind) != reported_.end()) return;
+  reported_.push_back(kind);
+  std::fprintf(stderr, "rheofeed: %s: %s (first %s of this run; all are counted)\n",
+               toString(method_), line.c_str(), kind.c_str());
+}
 
 void PartSimulation::spawnDue() {
   while (next_ < instances_.size() && instances_[next_].spawn_time <= time_ + 1e-12) {
-    addPart(instances_[next_++]);
-    active_.push_back(true);
+    const PartInstance& p = instances_[next_++];
+    addPart(p);
+    Track tr;
+    partSizes(p.shape, tr.min_half_size, tr.radius);
+    tr.last = partState(static_cast<int>(tracks_.size()));
+    tr.beyond_exit = beyondExitPlane(scene_.outputs, tr.last.position);
+    tracks_.push_back(tr);
+  }
+}
+
+double PartSimulation::firstCrossing(const Vec3& a, const Vec3& b, Vec3* normal) {
+  const Vec3 d = b - a;
+  const double length = norm(d);
+  if (!(length > 0) || fixture_geoms_.empty()) return kInf;
+  if (!ray_) {
+    ray_ = dCreateRay(nullptr, length);
+    dGeomRaySetClosestHit(ray_, 1);  // meshes: the nearest triangle, not any
+  }
+  dGeomRaySetLength(ray_, length);
+  dGeomRaySet(ray_, a.x, a.y, a.z, d.x, d.y, d.z);
+  dReal ray_box[6], box[6];
+  dGeomGetAABB(ray_, ray_box);
+  double first = kInf;
+  for (dGeomID g : fixture_geoms_) {
+    dGeomGetAABB(g, box);
+    if (box[1] < ray_box[0] || box[0] > ray_box[1] || box[3] < ray_box[2] || box[2] > ray_box[3] ||
+        box[5] < ray_box[4] || box[4] > ray_box[5]) {
+      continue;
+    }
+    dContactGeom contact;
+    if (dCollide(ray_, g, 1, &contact, sizeof contact) > 0 && contact.depth < first) {
+      first = contact.depth;
+      if (normal) *normal = {contact.normal[0], contact.normal[1], contact.normal[2]};
+    }
+  }
+  return first;
+}
+
+void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const PartState& s) {
+  Track& tr = tracks_[i];
+  const Vec3 to = s.position;
+  const double length = norm(to - from);
+  Vec3 normal;
+  const double forward = firstCrossing(from, to, &normal);
+  if (!(forward <= length)) return;  // no surface crossed
+  const Vec3 u = (1.0 / length) * (to - from);
+  const char* kind = "part through a fixture";
+  if (!tr.inside) {
+    const double backward = firstCrossing(to, from);
+    if (forward + backward < length - kCrossingTolerance) {  // in and out within the step
+      countLoss(i, kind, "passed through a fixture within one step (tunnelled; kept)",
+                health_.parts_through_fixture, s);
+      return;
+    }
+    tr.inside = true;  // the centre is inside a fixture now
+    tr.entry_point = from + forward * u;
+    tr.entry_normal = dot(normal, u) < 0 ? normal : -normal;  // outward: against the motion
+    return;
+  }
+  tr.inside = false;
+  if (dot(to - tr.entry_point, tr.entry_normal) > 0) {  // back out on the side it entered
+    if (!tr.sunk_counted) {
+      tr.sunk_counted = true;
+      ++health_.parts_sunk;
+      std::ostringstream line;
+      line << "part " << i << "'s centre went into a fixture and came back out at t = " << time_
+           << " s, x = " << formatPosition(to) << " (a penetration deeper than half the part)";
+      reportFirst("part sunk into a fixture", line.str());
+    }
+    return;
+  }
+  countLoss(i, kind, "passed through a fixture over several steps (tunnelled; kept)",
+            health_.parts_through_fixture, s);
+}
+
+void PartSimulation::countLoss(std::size_t i, const std::string& kind, const std::string& what,
+                               int& counter, const PartState& state) {
+  Track& tr = tracks_[i];
+  if (tr.counted) return;
+  tr.counted = true;
+  ++counter;
+  std::ostringstream line;
+  line << "part " << i << " " << what << " at t = " << time_
+       << " s, x = " << formatPosition(state.position) << ", v = " << formatPosition(state.velocity)
+       << "/s, |w| = " << norm(state.angular_velocity) << " rad/s";
+  reportFirst(kind, line.str());
+}
+
+void PartSimulation::remove(std::size_t i, PartCheck check, const PartState& state,
+                            const PartState& park) {
+  Track& tr = tracks_[i];
+  tr.active = false;
+  tr.last = park;
+  removePart(static_cast<int>(i), park);
+  switch (check) {
+    case PartCheck::NonFinite:
+      countLoss(i, "non-finite part", "has a non-finite state (removed)", health_.parts_nonfinite,
+                state);
+      return;
+    case PartCheck::TooFast: {
+      std::ostringstream what;
+      what << "moves faster (" << partSpeed(state, tr.radius)
+           << " m/s at its fastest point) than the scene's speed bound " << limits_.speed_bound
+           << " m/s (removed)";
+      countLoss(i, "too-fast part", what.str(), health_.parts_too_fast, state);
+      return;
+    }
+    case PartCheck::BelowRemovalHeight:
+    case PartCheck::OutOfBounds:
+      if (tr.inside && !tr.beyond_exit) {  // went into a fixture and out of the scene
+        countLoss(i, "part through a fixture",
+                  "passed through a fixture and left the scene (removed)",
+                  health_.parts_through_fixture, state);
+      } else if (tr.beyond_exit) {
+        if (!tr.counted) ++health_.parts_exited;
+        tr.counted = true;
+      } else if (check == PartCheck::BelowRemovalHeight) {
+        countLoss(i, "fallen part",
+                  "fell below the removal height without crossing an exit plane (removed)",
+                  health_.parts_fell, state);
+      } else {
+        countLoss(i, "part out of bounds", "left the scene bounds (removed)",
+                  health_.parts_out_of_bounds, state);
+      }
+      return;
+    case PartCheck::Ok:
+      return;
   }
 }
 
@@ -37,23 +436,45 @@ void PartSimulation::step() {
   const double h = scene_.solver.time_step;
   advance(h);
   time_ = ++steps_ * h;
-  for (std::size_t i = 0; i < active_.size(); ++i) {
-    if (!active_[i]) continue;
-    const Vec3 x = partState(static_cast<int>(i)).position;
-    checkPart(static_cast<int>(i), x, method_, time_);
-    if (x.z < scene_.removal_height) {  // left the scene: out of the simulation for good
-      removePart(static_cast<int>(i));
-      active_[i] = false;
+  health_.steps = steps_;
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    Track& tr = tracks_[i];
+    if (!tr.active) continue;
+    const PartState s = partState(static_cast<int>(i));
+    const PartCheck check = checkPartState(s, limits_, tr.radius);
+    if (check == PartCheck::NonFinite) {  // parked at its last finite state
+      remove(i, check, s, tr.last);
+      continue;
     }
+    health_.max_part_speed = std::max(health_.max_part_speed, partSpeed(s, tr.radius));
+    if (check == PartCheck::TooFast) {
+      remove(i, check, s, s);
+      continue;
+    }
+    tr.beyond_exit = tr.beyond_exit || beyondExitPlane(scene_.outputs, s.position);
+    if (!tr.counted && !tr.beyond_exit &&
+        (tr.inside ||
+         norm(s.position - tr.last.position) > kTunnelCheckFraction * tr.min_half_size)) {
+      trackCrossings(i, tr.last.position, s);
+    }
+    if (check != PartCheck::Ok) {
+      remove(i, check, s, s);
+      continue;
+    }
+    tr.last = s;
   }
   totals_ = fixtureImpulses(h);
   spawnDue();
 }
 
 PartState PartSimulation::part(int index) const {
-  PartState s = partState(index);
-  s.active = active_.at(static_cast<std::size_t>(index));
-  return s;
+  const Track& tr = tracks_.at(static_cast<std::size_t>(index));
+  if (!tr.active) {
+    PartState s = tr.last;
+    s.active = false;
+    return s;
+  }
+  return partState(index);
 }
 
 double PartSimulation::partMass(int index) const {

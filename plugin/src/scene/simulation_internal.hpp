@@ -5,6 +5,7 @@
 #include <ode/ode.h>
 
 #include <memory>
+#include <string>
 #include <unordered_set>
 #include <vector>
 
@@ -13,14 +14,16 @@
 namespace rheofeed::scene {
 
 /// What the ODE and the reference simulations share: the parts drawn from the scene, spawning
-/// them when due, taking out those below Scene::removal_height, refusing unstable states, time
-/// keeping. An engine implements the hooks; its constructor builds the fixtures and then calls
-/// spawnDue().
+/// them when due, the checks after each step that take out and count lost parts (RunHealth),
+/// the tunnelling test against the fixture geoms, time keeping. An engine implements the
+/// hooks; its constructor builds the fixtures (registering each geom with addFixtureGeom) and
+/// then calls spawnDue().
 class PartSimulation : public Simulation {
  public:
+  ~PartSimulation() override;
   void step() final;
   double time() const final { return time_; }
-  int numParts() const final { return static_cast<int>(active_.size()); }
+  int numParts() const final { return static_cast<int>(tracks_.size()); }
   PartState part(int index) const final;
   double partMass(int index) const final;
   ContactTotals contactTotals() const final { return totals_; }
@@ -37,23 +40,58 @@ class PartSimulation : public Simulation {
   virtual void addPart(const PartInstance& part) = 0;
   /// The state of part `index` (the `active` flag is filled in by part()).
   virtual PartState partState(int index) const = 0;
-  /// Takes part `index` out of the simulation for good.
-  virtual void removePart(int index) = 0;
+  /// Takes part `index` out of the simulation for good; `last` is a finite state the engine
+  /// may park it in (its state may be non-finite).
+  virtual void removePart(int index, const PartState& last) = 0;
   /// Impulses from fixtures on parts during the last step of h seconds.
   virtual ContactTotals fixtureImpulses(double h) const = 0;
   /// Whether `geom` belongs to a fixture (for fixtureImpulses).
-  bool isFixture(dGeomID geom) const { return fixture_geoms_.count(geom) != 0; }
-  void addFixtureGeom(dGeomID geom) { fixture_geoms_.insert(geom); }
+  bool isFixture(dGeomID geom) const { return fixture_set_.count(geom) != 0; }
+  /// Registers a fixture geom (placed at its rest pose) for isFixture and the tunnelling test.
+  void addFixtureGeom(dGeomID geom);
+  /// Lists a setting the engine ignores (health_.ignored_settings) and prints it on stderr.
+  void ignoreSetting(const std::string& message);
+  /// Prints one line on stderr the first time `kind` (a short name) is seen in this run.
+  void reportFirst(const std::string& kind, const std::string& line);
 
   const Scene scene_;
   RunHealth health_;
 
  private:
+  struct Track {
+    PartState last;            // state after the previous check (finite)
+    double min_half_size = 0;  // smallest half-size of the part (m)
+    double radius = 0;         // bounding radius about the centre of mass (m)
+    bool active = true;
+    bool beyond_exit = false;   // has been beyond the exit plane
+    bool counted = false;       // counted in a RunHealth loss (or as an exit) already
+    bool sunk_counted = false;  // counted in parts_sunk already
+    // Centre inside a fixture: where it entered (m) and the entry surface's outward normal.
+    bool inside = false;
+    Vec3 entry_point, entry_normal;
+  };
+  // Distance (m) from a along the segment a -> b to the first fixture surface it crosses
+  // (ODE ray test at the geoms' current poses); infinity when it crosses none. `normal`
+  // (optional) receives the surface normal there (unit, either orientation).
+  double firstCrossing(const Vec3& a, const Vec3& b, Vec3* normal = nullptr);
+  // The tunnelling test of part i moving from `from` to state s (simulation.cpp).
+  void trackCrossings(std::size_t i, const Vec3& from, const PartState& s);
+  // Takes part i out, parked at `park`, and counts it under `check` (unless counted already);
+  // `state` is the state that failed the check.
+  void remove(std::size_t i, PartCheck check, const PartState& state, const PartState& park);
+  // Counts part i under `counter` unless it was counted already; reports the first of `kind`.
+  void countLoss(std::size_t i, const std::string& kind, const std::string& what, int& counter,
+                 const PartState& state);
+
   const Method method_;
   const std::vector<PartInstance> instances_;
+  const SceneLimits limits_;
   std::size_t next_ = 0;
-  std::vector<bool> active_;
-  std::unordered_set<dGeomID> fixture_geoms_;
+  std::vector<Track> tracks_;
+  std::unordered_set<dGeomID> fixture_set_;  // lookups only: never iterated
+  std::vector<dGeomID> fixture_geoms_;       // in creation order (deterministic iteration)
+  dGeomID ray_ = nullptr;                    // for firstCrossing, in no space
+  std::vector<std::string> reported_;        // kinds already reported on stderr
   double time_ = 0;
   long steps_ = 0;
   ContactTotals totals_;
@@ -61,9 +99,5 @@ class PartSimulation : public Simulation {
 
 std::unique_ptr<Simulation> makeOdeSimulation(const Scene& scene, Method method);
 std::unique_ptr<Simulation> makeReferenceSimulation(const Scene& scene, Method method);
-
-/// Throws std::runtime_error if part `index` at position `x` (m) is non-finite or beyond
-/// 1e4 m: an unstable step, caught before ODE's collision asserts on it.
-void checkPart(int index, const Vec3& x, Method method, double time);
 
 }  // namespace rheofeed::scene

@@ -28,6 +28,8 @@ struct DriftSample {
   double ci95 = 0;           ///< half-width of the 95 % confidence interval of the mean (m/s)
   double mean_height = 0;    ///< mean z of the parts (m)
   int exited = 0;            ///< parts that have crossed the exit plane so far
+  /// Parts lost so far, by kind (RunHealth, cumulative at `time`).
+  int fell = 0, through_fixture = 0, out_of_bounds = 0, nonfinite = 0, too_fast = 0;
 };
 
 /// The result of one run.
@@ -48,13 +50,17 @@ struct RunMetrics {
   double simulated_seconds = 0;
   /// CPU time / simulated time (dimensionless; < 1 is faster than real time).
   double real_time_factor = 0;
+  /// What the run lost, could not trust or ignored (simulation.hpp).
+  RunHealth health;
 };
 
 /// Progress report: fraction done in [0, 1].
 using Progress = std::function<void(double fraction)>;
 
 /// Runs `scene` with `method` for its duration and measures it. `progress` (optional) is called
-/// about a hundred times. Throws std::invalid_argument for an invalid scene.
+/// about a hundred times. Throws std::invalid_argument for an invalid scene. When the run lost
+/// parts, had reference steps it cannot trust or ignored settings (RunHealth::anything), one
+/// summary line is printed on stderr at the end (healthSummary).
 RunMetrics measureRun(const Scene& scene, Method method, const Progress& progress = {});
 
 /// A progress printer for stderr: "label: 42 %" on one refreshed line, at most every 0.5 s.
@@ -63,10 +69,17 @@ Progress stderrProgress(const std::string& label);
 /// Two-sided 95 % Student-t quantile for `dof` degrees of freedom (1.96 for large dof).
 double studentT95(int dof);
 
-/// CSV of the series: time_s,parts,mean_velocity_mps,ci95_mps,mean_height_m,exited.
+/// CSV of the series: time_s,parts,mean_velocity_mps,ci95_mps,mean_height_m,exited, then the
+/// parts lost so far by kind (cumulative counts, RunHealth): lost_fell,lost_through_fixture,
+/// lost_out_of_bounds,lost_nonfinite,lost_too_fast.
 std::string seriesCsv(const RunMetrics& run);
-/// One-line JSON summary of a run (all scalar fields).
+/// One-line JSON summary of a run: all scalar fields and a "health" object with every count of
+/// RunHealth, parts_lost, the share of Coulomb fallback steps, the maximum part speed and its
+/// bound, and the list of ignored settings.
 std::string summaryJson(const RunMetrics& run);
+/// One line naming what a run lost, could not trust or ignored, e.g. "3 of 60 parts lost
+/// (fell 2, through a fixture 1); ..."; "nothing lost" when RunHealth::anything() is false.
+std::string healthSummary(const RunHealth& health, int parts);
 
 /// Writes <stem>.csv, <stem>.json and, when gnuplot is available, <stem>.png (mean drift vs time
 /// with the 95 % band) into `folder`, each atomically. Returns the paths written; a missing

@@ -19,8 +19,9 @@ struct PartState {
   Vec3 velocity;                                     ///< (m/s)
   Vec3 angular_velocity;                             ///< (rad/s)
   double rotation[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< body to world, row-major
-  /// False once the part fell below Scene::removal_height and was taken out of the simulation
-  /// (its state is then frozen where it was removed).
+  /// False once the part was taken out of the simulation (below Scene::removal_height, beyond
+  /// the scene bounds, non-finite or too fast: RunHealth). Its state is then frozen where it
+  /// was removed; a part removed for a non-finite state keeps its last finite state.
   bool active = true;
 };
 
@@ -32,48 +33,131 @@ struct ContactTotals {
 };
 
 /// What a run lost, could not trust or ignored, counted since the start (issue 7: no silent
-/// failure). Every count is also reported on stderr when it first becomes non-zero and written
-/// into the run's JSON and CSV outputs.
+/// failure). The first occurrence of each kind is reported on stderr (part, time, position);
+/// measureRun prints the totals and writes them into the run's JSON and CSV outputs.
+///
+/// Each part is counted at most once, under the first of these that happened to it (checked
+/// after every step in the order non-finite, too fast, through a fixture, below the removal
+/// height or beyond the bounds), so partsLost() is a number of parts. A part that goes below
+/// Scene::removal_height or beyond the scene bounds after it was beyond the exit plane
+/// (Outputs::exit_plane, beyondExitPlane) is an exit, not a loss.
 struct RunHealth {
   long steps = 0;  ///< steps taken
-  /// Parts removed below Scene::removal_height after crossing the exit plane: normal flow.
+  /// Parts removed below Scene::removal_height (or beyond the scene bounds) after being beyond
+  /// the exit plane: normal flow.
   int parts_exited = 0;
-  /// Parts removed below Scene::removal_height without crossing the exit plane (fell off an
-  /// edge, or over a wall or rim).
+  /// Parts removed below Scene::removal_height without having been beyond the exit plane (fell
+  /// off an edge, or over a wall or rim).
   int parts_fell = 0;
-  /// Parts whose centre crossed a fixture surface within one step (tunnelling: through a floor
-  /// or a wall). They stay in the simulation; each part is counted once.
+  /// Parts whose centre passed through a fixture (tunnelling: through a floor or a wall): within
+  /// one step, or into it and out on another side, or into it and then out of the scene. They
+  /// stay in the simulation until they leave it; each part is counted once. Parts beyond the
+  /// exit plane are not checked (they are out of the measurement).
   int parts_through_fixture = 0;
-  /// Parts removed because they left the scene bounds (far beyond the fixtures) sideways or up.
+  /// Parts whose centre went into a fixture (a penetration deeper than half the part) and came
+  /// back out on the side it entered: not lost, but the contact did not hold them. Counted once
+  /// per part; not part of partsLost().
+  int parts_sunk = 0;
+  /// Parts removed because they left the scene bounds (SceneLimits::bounds) sideways or up.
   int parts_out_of_bounds = 0;
   /// Parts whose state (position, velocity, angular velocity, orientation) became NaN or
   /// infinite; they are removed at once.
   int parts_nonfinite = 0;
-  /// Parts that went faster than the scene's physical speed bound (energy blow-up); counted
-  /// once each, then removed.
+  /// Parts that went faster than the scene's speed bound (SceneLimits::speed_bound: an energy
+  /// blow-up); counted once each, then removed.
   int parts_too_fast = 0;
   /// Reference engine: steps whose true-Coulomb fixed point did not settle and that used the
-  /// fallback (0 for ODE), and steps whose contact solve stopped at the iteration limit.
+  /// fallback (0 for ODE), and steps with contacts whose contact solve did not converge
+  /// (iteration limit or numerical issue; 0 for ODE, which reports no convergence).
   long coulomb_fallback_steps = 0;
   long solver_unconverged_steps = 0;
-  /// Settings of the scene this engine does not use (e.g. "solver.coulomb_iterations = 10:
-  /// ignored by ODE"), reported once at the start.
+  /// Settings of the scene this engine does not use although they differ from the
+  /// SolverSettings / Material defaults (e.g. "solver.coulomb_iterations = 3: ignored by
+  /// ode_rheonomic (...)"), listed and printed once when the simulation is built.
   std::vector<std::string> ignored_settings;
+  /// Highest speed (partSpeed: fastest point, |v| + |w| r) of a part seen after any step (m/s),
+  /// non-finite states excluded, and the bound it is checked against (m/s,
+  /// SceneLimits::speed_bound).
+  double max_part_speed = 0;
+  double speed_bound = 0;
   /// Parts lost in any way but the exit: fell + through_fixture + out_of_bounds + nonfinite +
   /// too_fast.
   int partsLost() const {
     return parts_fell + parts_through_fixture + parts_out_of_bounds + parts_nonfinite +
            parts_too_fast;
   }
+  /// Whether anything was lost, not trusted or ignored.
+  bool anything() const {
+    return partsLost() > 0 || parts_sunk > 0 || coulomb_fallback_steps > 0 ||
+           solver_unconverged_steps > 0 || !ignored_settings.empty();
+  }
 };
+
+/// Axis-aligned box (m, world frame).
+struct Bounds {
+  Vec3 min, max;
+  bool contains(const Vec3& x) const {
+    return x.x >= min.x && x.x <= max.x && x.y >= min.y && x.y <= max.y && x.z >= min.z &&
+           x.z <= max.z;
+  }
+};
+
+/// What a scene allows physically, computed once from the scene description (fixtures at
+/// rest, spawn regions, laws, gravity). Derivations in simulation.cpp.
+struct SceneLimits {
+  /// Union of the fixtures' bounding boxes (plane geoms excluded) and the spawn regions (m).
+  Bounds extent;
+  /// The scene bounds: `extent` expanded by `margin` on every side, except downwards, where
+  /// Scene::removal_height takes parts out (its min.z is -infinity).
+  Bounds bounds;
+  double margin = 0;            ///< (m)
+  double removal_height = 0;    ///< Scene::removal_height (m)
+  double surface_speed = 0;     ///< fastest feeder surface point (m/s)
+  double fall_speed = 0;        ///< free fall from the highest point to the removal height (m/s)
+  double initial_speed = 0;     ///< fastest initial part velocity (m/s)
+  double correcting_speed = 0;  ///< SolverSettings::max_correcting_velocity (m/s)
+  /// initial + fall + 2 surface + correcting: the fastest a part can move (m/s).
+  double physical_speed = 0;
+  /// kSpeedBoundFactor physical_speed + kSpeedBoundMargin: a part above it is too fast (m/s).
+  double speed_bound = 0;
+};
+/// Factor and margin (m/s) between SceneLimits::physical_speed and speed_bound.
+constexpr double kSpeedBoundFactor = 2.0;
+constexpr double kSpeedBoundMargin = 1.0;
+
+/// The limits of `scene` (SI units, world frame). Does not validate the scene.
+SceneLimits sceneLimits(const Scene& scene);
+
+/// Whether x (m) is on the exit side of the Outputs exit plane: (x - exit_point) . exit_normal
+/// >= 0. False when the scene has no exit plane. Shared by the simulations and the metrics.
+bool beyondExitPlane(const Outputs& outputs, const Vec3& x);
+
+/// What the checks after a step say about a part's state (RunHealth), in the order tried.
+enum class PartCheck {
+  Ok,                  ///< stays
+  NonFinite,           ///< a NaN or infinite value in position, velocity, w or rotation
+  TooFast,             ///< speed above SceneLimits::speed_bound
+  BelowRemovalHeight,  ///< z < Scene::removal_height
+  OutOfBounds,         ///< outside SceneLimits::bounds
+};
+/// Printable name of a PartCheck ("ok", "non-finite", "too fast", ...).
+const char* toString(PartCheck check);
+/// Speed of the fastest point of a part (m/s): |v| + |w| radius, `radius` (m) its bounding
+/// radius about the centre of mass.
+double partSpeed(const PartState& state, double radius);
+/// Classifies a part's state after a step; `radius` (m) is its bounding radius (partSpeed).
+/// Tunnelling needs the geometry and is checked by the simulation itself.
+PartCheck checkPartState(const PartState& state, const SceneLimits& limits, double radius);
 
 class Simulation {
  public:
   virtual ~Simulation() = default;
-  /// Advance one time step of scene.solver.time_step (s), spawning the parts that are due and
-  /// removing those below Scene::removal_height. Throws std::runtime_error naming the part if
-  /// a part's state becomes non-finite or flies out of the scene (|x| > 1e4 m), which only an
-  /// unstable step causes, before the collision engine sees it.
+  /// Advance one time step of scene.solver.time_step (s), spawning the parts that are due. After
+  /// the step every active part is checked (RunHealth): a part with a non-finite state, faster
+  /// than the scene's speed bound, below Scene::removal_height or beyond the scene bounds is
+  /// taken out of the simulation and counted; a part whose centre crossed a fixture surface is
+  /// counted and kept. Nothing is thrown for a bad state: the first part of each kind is named
+  /// on stderr, the counts are in health().
   virtual void step() = 0;
   /// Simulated time (s).
   virtual double time() const = 0;
@@ -90,7 +174,15 @@ class Simulation {
 };
 
 /// Builds the scene for `method`. Throws std::invalid_argument for an invalid scene or a
-/// rheonomic method on a vibrating feeder without calibrated drift.
+/// rheonomic method on a vibrating feeder without calibrated drift. Settings the engine ignores
+/// are listed in health().ignored_settings and printed on stderr.
+///
+/// Determinism: the same scene gives bit-identical part states in every run. ODE's quickstep
+/// reorders its constraints with ODE's process-wide random generator (dRandSetSeed); an ODE
+/// simulation seeds its own generator state from Scene::seed, swaps it in around each of its
+/// steps and swaps the application's state back afterwards, so simulations interleaved in one
+/// thread do not disturb each other or the application. Simulations stepped concurrently in
+/// several threads do share (and race on) that global.
 std::unique_ptr<Simulation> makeSimulation(const Scene& scene, Method method);
 
 }  // namespace rheofeed::scene
