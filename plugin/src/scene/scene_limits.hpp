@@ -6,6 +6,9 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
+#include <string>
+#include <system_error>
 
 namespace rheofeed::scene::limits {
 
@@ -84,5 +87,40 @@ constexpr long kMaxTriangles = 1000000;
 // degenerate (flat or a sliver): a 0.5 mm x 10 cm x 10 cm plate is 3e-3, a 10 um x 1 m x 1 m foil
 // 7e-6; below 1e-6 the inertia is dominated by rounding.
 constexpr double kMinVolumeFraction = 1e-6;
+
+// "" when `file` is a regular file (symbolic links followed) of 1 to max_bytes bytes, else what
+// it is: missing, a directory, a FIFO, a socket, a device, empty or too large. Uses stat only,
+// never opens the file, so that a FIFO or a device is refused without blocking or reading.
+inline std::string regularFileProblem(const std::filesystem::path& file, std::uintmax_t max_bytes) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status status = fs::status(file, ec);
+  if (status.type() == fs::file_type::not_found) return "file not found";
+  if (ec) return "cannot access the file: " + ec.message();
+  switch (status.type()) {
+    case fs::file_type::regular:
+      break;
+    case fs::file_type::directory:
+      return "is a directory, not a regular file";
+    case fs::file_type::fifo:
+      return "is a FIFO (named pipe), not a regular file";
+    case fs::file_type::socket:
+      return "is a socket, not a regular file";
+    case fs::file_type::character:
+      return "is a character device, not a regular file";
+    case fs::file_type::block:
+      return "is a block device, not a regular file";
+    default:
+      return "is not a regular file";
+  }
+  const std::uintmax_t bytes = fs::file_size(file, ec);
+  if (ec) return "cannot read the file size: " + ec.message();
+  if (bytes == 0) return "the file is empty";
+  if (bytes > max_bytes) {
+    return "the file is " + std::to_string(bytes) + " bytes; at most " + std::to_string(max_bytes) +
+           " bytes (" + std::to_string(max_bytes >> 20) + " MiB) are read";
+  }
+  return "";
+}
 
 }  // namespace rheofeed::scene::limits
