@@ -667,9 +667,14 @@ void checkFixtureMesh(const TriangleMesh& mesh, const Vec3& position, const std:
   }
   const double diagonal = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
   const std::string name = "mesh '" + mesh.source + "'";
+  auto range = [](double lo, double hi) {  // as Scene::validate writes its ranges
+    std::ostringstream out;
+    out << "[" << lo << ", " << hi << "] m";
+    return out.str();
+  };
   if (!(diagonal >= limits::kMinSize && diagonal <= limits::kMaxSize)) {
-    fail(path, name + ": scaled bounding box diagonal " + show(diagonal) + " m must be in [" +
-                   show(limits::kMinSize) + ", " + show(limits::kMaxSize) + "] m");
+    fail(path, name + ": scaled bounding box diagonal " + show(diagonal) + " m must be in " +
+                   range(limits::kMinSize, limits::kMaxSize));
   }
   // The geom may be rotated: bound every vertex by the farthest one from the mesh origin.
   const double reach = boundingRadius(mesh);
@@ -678,8 +683,8 @@ void checkFixtureMesh(const TriangleMesh& mesh, const Vec3& position, const std:
     if (!(std::abs(p[k]) + reach <= limits::kMaxCoordinate)) {
       fail(path, name + ": vertices reach " + show(std::abs(p[k]) + reach) +
                      " m from the origin along " + std::string(1, "xyz"[k]) +
-                     "; coordinates must be in [" + show(-limits::kMaxCoordinate) + ", " +
-                     show(limits::kMaxCoordinate) + "] m");
+                     "; coordinates must be in " +
+                     range(-limits::kMaxCoordinate, limits::kMaxCoordinate));
     }
   }
 }
