@@ -7,6 +7,10 @@
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <filesystem>
 #include <fstream>
@@ -168,6 +172,136 @@ TEST(Fc3dReader, ParsesFromStreamWithSourceName) {
   } catch (const std::runtime_error& error) {
     RHEOFEED_EXPECT_CONTAINS(std::string(error.what()), "in-memory: q:");
   }
+}
+
+// ---- Limits (issue 9): claimed sizes against the data, kinds of file, values -------------------
+
+// The message of parsing `text` from memory as "mem.dat", or "" when it parses.
+std::string parseError(const std::string& text) {
+  std::istringstream in(text);
+  try {
+    parseFc3d(in, "mem.dat");
+  } catch (const std::runtime_error& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(Fc3dReaderLimits, HeaderClaimingTenMillionContactsIsRefusedWithTheCap) {
+  const std::string path = writeTempFile("huge_nc.dat", "3\n10000000\n0\n");
+  const std::string message = readError(path);
+  RHEOFEED_EXPECT_CONTAINS(message, path);
+  RHEOFEED_EXPECT_CONTAINS(message, "nc = 10000000 is outside [1, 5461]");
+  RHEOFEED_EXPECT_CONTAINS(message, "2 GiB");
+}
+
+TEST(Fc3dReaderLimits, DenseHeaderClaimingMoreValuesThanTheFileHoldsIsRefusedBeforeAllocating) {
+  // 5000 contacts: W would be 15000 x 15000 (1.8 GB); the file holds 3 values.
+  const std::string message = parseError("3 5000 0 15000 15000 15000 15000 1 2 3");
+  RHEOFEED_EXPECT_CONTAINS(message, "mem.dat: W (dense storage)");
+  RHEOFEED_EXPECT_CONTAINS(message, "need at least 225000000 more values");
+  RHEOFEED_EXPECT_CONTAINS(message, "holds only 3 more tokens");
+}
+
+TEST(Fc3dReaderLimits, SparseFileWithOneHugeBlockIsRefusedBeforeAllocating) {
+  // One 15000 x 15000 block claimed, 9 values present.
+  const std::string message =
+      parseError("3 5000 1 15000 15000 1 1 1 15000 15000 2 1 0 1 0 0 1 2 3 4 5 6 7 8 9");
+  RHEOFEED_EXPECT_CONTAINS(message, "W block pattern");
+  RHEOFEED_EXPECT_CONTAINS(message, "the 1 blocks (225000000 values and their indices)");
+}
+
+TEST(Fc3dReaderLimits, SparseFileMissingDiagonalBlocksIsRefusedBeforeBuildingW) {
+  // 5000 contacts in 5000 block rows and columns, but only block (0, 0) stored: a small file
+  // whose dense W (1.8 GB) would be zero but for one block.
+  std::ostringstream text;
+  text << "3 5000 1 15000 15000 1 5000 5000\n";
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int b = 1; b <= 5000; ++b) text << 3 * b << " ";
+    text << "\n";
+  }
+  text << "5001 1\n0";
+  for (int b = 1; b <= 5000; ++b) text << " 1";
+  text << "\n0\n0\n1 0 0 0 1 0 0 0 1\n";
+  const std::string message = parseError(text.str());
+  RHEOFEED_EXPECT_CONTAINS(message,
+                           "no stored block holds the diagonal entry W(3, 3) of contact 1");
+  RHEOFEED_EXPECT_CONTAINS(message, "singular");
+}
+
+TEST(Fc3dReaderLimits, NonFiniteValuesAreRefusedWithTheirPlace) {
+  std::string text = kDenseOneContact;
+  text.replace(text.find("5 6"), 1, "nan");
+  std::string message = readError(writeTempFile("nan.dat", text));
+  RHEOFEED_EXPECT_CONTAINS(message, "W(1, 1) = 'nan' is not a finite number");
+  text = kDenseOneContact;
+  text.replace(text.find("0.5 0.25"), 3, "1e999");
+  message = readError(writeTempFile("inf.dat", text));
+  RHEOFEED_EXPECT_CONTAINS(message, "q: q[1] = '1e999' is not a finite number");
+}
+
+TEST(Fc3dReaderLimits, NegativeFrictionCoefficientIsRefused) {
+  std::string text = kSparseTwoContacts;
+  text.replace(text.find("0.5 0.7"), 7, "0.5 -0.7");
+  const std::string path = writeTempFile("negative_mu.dat", text);
+  const std::string message = readError(path);
+  RHEOFEED_EXPECT_CONTAINS(message, path);
+  RHEOFEED_EXPECT_CONTAINS(message, "mu[1] = -0.700000 is negative");
+  RHEOFEED_EXPECT_CONTAINS(message, ">= 0");
+}
+
+TEST(Fc3dReaderLimits, TrailingGarbageIsRefused) {
+  const std::string message =
+      readError(writeTempFile("garbage.dat", std::string(kDenseOneContact) + "1 abc\n"));
+  RHEOFEED_EXPECT_CONTAINS(message, "trailing data");
+  RHEOFEED_EXPECT_CONTAINS(message, "got 'abc'");
+}
+
+TEST(Fc3dReaderLimits, TruncatedSparseBlocksAreRefused) {
+  std::string text = kSparseTwoContacts;
+  text = text.substr(0, text.find("2\n21 22"));  // the third block is missing
+  const std::string message = readError(writeTempFile("truncated_sparse.dat", text));
+  RHEOFEED_EXPECT_CONTAINS(message, "W block pattern");
+  RHEOFEED_EXPECT_CONTAINS(message, "truncated file or wrong header");
+}
+
+TEST(Fc3dReaderLimits, FifoIsRefusedWithoutBlocking) {
+  const fs::path dir = fs::path(testing::TempDir()) / "rheofeed_fc3d_reader_test";
+  fs::create_directories(dir);
+  const fs::path fifo = dir / "problem.fifo";
+  fs::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  const std::string message = readError(fifo.string());  // would block if opened
+  RHEOFEED_EXPECT_CONTAINS(message, fifo.string());
+  RHEOFEED_EXPECT_CONTAINS(message, "is a FIFO (named pipe), not a regular file");
+  fs::remove(fifo);
+}
+
+TEST(Fc3dReaderLimits, DirectoryAndDeviceAreRefused) {
+  RHEOFEED_EXPECT_CONTAINS(readError(testing::TempDir()), "is a directory, not a regular file");
+  if (fs::exists("/dev/zero")) {
+    RHEOFEED_EXPECT_CONTAINS(readError("/dev/zero"), "is a device, not a regular file");
+  }
+}
+
+TEST(Fc3dReaderLimits, FileBeyondTheSizeCapIsRefusedBeforeReading) {
+  const std::string path = writeTempFile("big.dat", "3 1");
+  fs::resize_file(path, (std::uintmax_t{1} << 30) + 1);  // sparse: nothing is written
+  const std::string message = readError(path);
+  RHEOFEED_EXPECT_CONTAINS(message, "the file is 1073741825 bytes; at most 1024 MiB are read");
+  fs::remove(path);
+}
+
+TEST(Fc3dReaderLimits, EmptyFileIsRefused) {
+  RHEOFEED_EXPECT_CONTAINS(readError(writeTempFile("empty.dat", "  \n")),
+                           "header: the file holds no data");
+}
+
+TEST(Fc3dReaderLimits, ZeroStoredBlocksAreRefused) {
+  std::string text = kSparseTwoContacts;
+  text.replace(text.find("3\n2\n2\n"), 6, "0\n2\n2\n");
+  RHEOFEED_EXPECT_CONTAINS(readError(writeTempFile("no_blocks.dat", text)),
+                           "inconsistent block counts: nbblocks = 0");
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // Triangle meshes from files (assimp) and the mass properties of the solids they bound; the
 // derivation is in mesh.hpp.
 #include "rheofeed/scene/mesh.hpp"
+#include "scene_limits.hpp"
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -18,6 +19,8 @@ namespace rheofeed::scene {
 namespace {
 
 namespace fs = std::filesystem;
+
+constexpr double kPi = 3.14159265358979323846;
 
 // A closed surface has zero total area vector. Merged vertices close it to rounding error
 // (~1e-7 relative with the single-precision coordinates of STL files); a CAD export whose
@@ -78,14 +81,12 @@ TriangleMesh loadTriangleMesh(const fs::path& file, double scale) {
     throw std::invalid_argument(name + ": scale = " + number(scale) +
                                 " must be a finite number > 0");
   }
-  std::error_code ec;
-  const fs::file_status status = fs::status(file, ec);
-  if (!fs::exists(status)) throw std::runtime_error(name + ": file not found");
-  if (fs::is_directory(status)) throw std::runtime_error(name + ": is a directory, not a file");
+  // Kind and size from stat first: a FIFO, a device or a directory is never opened.
+  const std::string problem = limits::regularFileProblem(file, limits::kMaxMeshFileBytes);
+  if (!problem.empty()) throw std::runtime_error(name + ": " + problem);
   if (!std::ifstream(file, std::ios::binary)) {
     throw std::runtime_error(name + ": cannot open the file for reading");
   }
-  if (fs::file_size(file, ec) == 0 && !ec) throw std::runtime_error(name + ": the file is empty");
 
   Assimp::Importer importer;
   const aiScene* ai =
@@ -97,6 +98,16 @@ TriangleMesh loadTriangleMesh(const fs::path& file, double scale) {
         name + ": cannot read it (corrupt or unknown format): " + importer.GetErrorString());
   }
 
+  // Count before copying anything: ODE's trimesh collider must stay bounded (scene_limits.hpp).
+  long faces = 0;
+  for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
+    if (ai->mMeshes[m]->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)
+      faces += ai->mMeshes[m]->mNumFaces;
+  }
+  if (faces > limits::kMaxTriangles) {
+    throw std::runtime_error(name + ": " + std::to_string(faces) + " triangles; at most " +
+                             std::to_string(limits::kMaxTriangles) + " are allowed per mesh");
+  }
   TriangleMesh mesh;
   mesh.source = file.string();
   for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
@@ -172,6 +183,18 @@ MassProperties massProperties(const TriangleMesh& mesh, double density) {
     throw std::invalid_argument(name + ": signed volume " + number(volume) +
                                 " m^3 <= 0: the mesh is open or inside out (triangles must be "
                                 "counter-clockwise seen from outside)");
+  }
+  // A flat or sliver solid: its volume against the sphere about r0 through the farthest vertex.
+  double r2 = 0;
+  for (std::size_t i = 0; i < nv; ++i) {
+    const Vec3 d = vertex(mesh, static_cast<int>(i)) - r0;
+    r2 = std::max(r2, dot(d, d));
+  }
+  const double sphere = 4.0 / 3.0 * kPi * r2 * std::sqrt(r2);
+  if (!(volume >= limits::kMinVolumeFraction * sphere)) {
+    throw std::invalid_argument(name + ": degenerate solid: volume " + number(volume) + " m^3 is " +
+                                number(volume / sphere) + " of its bounding sphere's; at least " +
+                                number(limits::kMinVolumeFraction) + " is needed for a part");
   }
 
   MassProperties out;

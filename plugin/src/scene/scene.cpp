@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "rheofeed/scene/mesh.hpp"
+#include "scene_limits.hpp"
 
 namespace rheofeed::scene {
 namespace {
@@ -27,11 +28,25 @@ constexpr int kPlacementTries = 200;
   throw std::invalid_argument(out.str());
 }
 
+std::string show(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
 void positive(const std::string& path, double v) {
   if (!std::isfinite(v) || !(v > 0)) bad(path, v, "must be a finite number > 0");
 }
 void nonNegative(const std::string& path, double v) {
   if (!std::isfinite(v) || !(v >= 0)) bad(path, v, "must be a finite number >= 0");
+}
+// v in [lo, hi] (unit for the message, e.g. "m"); `why` says where the limit comes from.
+void within(const std::string& path, double v, double lo, double hi, const std::string& unit,
+            const std::string& why = "") {
+  if (std::isfinite(v) && v >= lo && v <= hi) return;
+  bad(path, v,
+      "must be a finite number in [" + show(lo) + ", " + show(hi) + "]" +
+          (unit.empty() ? "" : " " + unit) + (why.empty() ? "" : " (" + why + ")"));
 }
 void finite(const std::string& path, double v) {
   if (!std::isfinite(v)) bad(path, v, "must be finite");
@@ -45,38 +60,82 @@ void unit(const std::string& path, const Vec3& v) {
   finite(path, v);
   if (std::abs(norm(v) - 1.0) > 1e-6) bad(path + " length", norm(v), "must be a unit vector");
 }
+// A coordinate (m) within ODE's representable world.
+void coordinate(const std::string& path, double v) {
+  within(path, v, -limits::kMaxCoordinate, limits::kMaxCoordinate, "m",
+         "positions beyond this break ODE's hash space");
+}
+void position(const std::string& path, const Vec3& v) {
+  coordinate(path + ".x", v.x);
+  coordinate(path + ".y", v.y);
+  coordinate(path + ".z", v.z);
+}
+void size(const std::string& path, double v) {
+  within(path, v, limits::kMinSize, limits::kMaxSize, "m",
+         "mass and inertia must stay representable");
+}
+// |v| of a vector of finite components, with `what` naming the bound ("m/s").
+void magnitude(const std::string& path, const Vec3& v, double max, const std::string& unit) {
+  finite(path, v);
+  const double n = norm(v);
+  if (!(n <= max)) {
+    bad(path + " magnitude", n, "must be <= " + show(max) + " " + unit);
+  }
+}
 
 void validateShape(const std::string& path, const Shape& s, bool static_geom) {
   switch (s.kind) {
     case Shape::Kind::Box:
-      positive(path + ".size.x", s.size.x);
-      positive(path + ".size.y", s.size.y);
-      positive(path + ".size.z", s.size.z);
+      size(path + ".size.x", s.size.x);
+      size(path + ".size.y", s.size.y);
+      size(path + ".size.z", s.size.z);
       break;
     case Shape::Kind::Sphere:
-      positive(path + ".radius", s.radius);
+      size(path + ".radius", s.radius);
       break;
     case Shape::Kind::Cylinder:
     case Shape::Kind::Capsule:
-      positive(path + ".radius", s.radius);
-      positive(path + ".length", s.length);
+      size(path + ".radius", s.radius);
+      size(path + ".length", s.length);
       break;
     case Shape::Kind::Plane:
       if (!static_geom) throw std::invalid_argument(path + ".shape: a plane can only be static");
       unit(path + ".normal", s.plane_normal);
-      finite(path + ".offset", s.plane_offset);
+      coordinate(path + ".offset", s.plane_offset);
       break;
     case Shape::Kind::Mesh:
       if (s.mesh.empty()) throw std::invalid_argument(path + ".mesh: empty file name");
+      // The scaled mesh's extent is checked against the size limits when it is loaded.
       positive(path + ".scale", s.mesh_scale);
       break;
   }
 }
 
 void validateTwist(const std::string& path, const Twist& t) {
-  finite(path + ".linear", t.linear);
-  finite(path + ".angular", t.angular);
-  finite(path + ".origin", t.origin);
+  magnitude(path + ".linear", t.linear, limits::kMaxSpeed, "m/s");
+  magnitude(path + ".angular", t.angular, limits::kMaxAngularSpeed, "rad/s");
+  position(path + ".origin", t.origin);
+}
+
+// A size distribution; `lo` and `hi` bound the mean (the size limits, or the scale of a mesh).
+void validateDistribution(const std::string& path, const Distribution& d, bool mesh_scale) {
+  if (mesh_scale) {
+    positive(path + ".mean", d.mean);  // the scaled extent is checked when the mesh is loaded
+  } else {
+    size(path + ".mean", d.mean);
+  }
+  nonNegative(path + ".stddev", d.stddev);
+  if (!mesh_scale && d.stddev > limits::kMaxSize) {
+    bad(path + ".stddev", d.stddev, "must be <= " + show(limits::kMaxSize) + " m");
+  }
+  nonNegative(path + ".min", d.min);
+  if (std::isnan(d.max) || !(d.max >= d.min)) {
+    bad(path + ".max", d.max, "must be >= min (" + show(d.min) + ")");
+  }
+  if (!(d.mean >= d.min && d.mean <= d.max)) {
+    bad(path + ".mean", d.mean,
+        "must lie in [min, max] = [" + show(d.min) + ", " + show(d.max) + "]");
+  }
 }
 
 }  // namespace
@@ -144,42 +203,76 @@ Pose Vibration::displacement(double t) const {
 }
 
 void Scene::validate() const {
-  finite("gravity", gravity);
+  magnitude("gravity", gravity, limits::kMaxGravity, "m/s^2");
+  within("solver.time_step", solver.time_step, limits::kMinTimeStep, limits::kMaxTimeStep, "s");
   positive("duration", duration);
-  positive("solver.time_step", solver.time_step);
-  if (solver.iterations < 1) bad("solver.iterations", solver.iterations, "must be >= 1");
+  if (duration < solver.time_step) {
+    bad("duration", duration,
+        "must be >= solver.time_step (" + show(solver.time_step) +
+            " s): the run would take no step");
+  }
+  if (const double steps = duration / solver.time_step; !(steps <= limits::kMaxSteps)) {
+    bad("duration", duration,
+        "with solver.time_step = " + show(solver.time_step) + " s would take " + show(steps) +
+            " steps; at most " + show(limits::kMaxSteps) + " steps are allowed");
+  }
+  if (solver.iterations < 1 || solver.iterations > limits::kMaxIterations) {
+    bad("solver.iterations", solver.iterations,
+        "must be in [1, " + std::to_string(limits::kMaxIterations) + "]");
+  }
   if (!(solver.erp >= 0 && solver.erp <= 1)) bad("solver.erp", solver.erp, "must be in [0, 1]");
   nonNegative("solver.cfm", solver.cfm);
   positive("solver.max_correcting_velocity", solver.max_correcting_velocity);
-  nonNegative("solver.surface_layer", solver.surface_layer);
-  finite("removal_height", removal_height);
-  if (solver.coulomb_iterations < 0) {
-    bad("solver.coulomb_iterations", solver.coulomb_iterations, "must be >= 0");
+  within("solver.max_correcting_velocity", solver.max_correcting_velocity, 0, limits::kMaxSpeed,
+         "m/s");
+  within("solver.surface_layer", solver.surface_layer, 0, limits::kMaxSize, "m");
+  coordinate("removal_height", removal_height);
+  if (solver.coulomb_iterations < 0 || solver.coulomb_iterations > limits::kMaxIterations) {
+    bad("solver.coulomb_iterations", solver.coulomb_iterations,
+        "must be in [0, " + std::to_string(limits::kMaxIterations) + "]");
   }
   positive("solver.tolerance", solver.tolerance);
-  nonNegative("material.mu", material.mu);
+  within("material.mu", material.mu, 0, limits::kMaxMu, "");
   if (!(material.restitution >= 0 && material.restitution <= 1)) {
     bad("material.restitution", material.restitution, "must be in [0, 1]");
   }
   unit("outputs.conveying_direction", outputs.conveying_direction);
   positive("outputs.sample_interval", outputs.sample_interval);
+  if (outputs.sample_interval > duration) {
+    bad("outputs.sample_interval", outputs.sample_interval,
+        "must be <= duration (" + show(duration) + " s): the run would take no sample");
+  }
   nonNegative("outputs.warmup", outputs.warmup);
+  if (outputs.warmup > duration - solver.time_step) {
+    bad("outputs.warmup", outputs.warmup,
+        "must be <= duration - solver.time_step (" + show(duration - solver.time_step) +
+            " s): no drift would be measured after it");
+  }
   if (outputs.angular_drift) {
-    finite("outputs.axis_origin", outputs.axis_origin);
+    position("outputs.axis_origin", outputs.axis_origin);
     unit("outputs.axis_direction", outputs.axis_direction);
   }
   if (outputs.exit_plane) {
-    finite("outputs.exit_point", outputs.exit_point);
+    position("outputs.exit_point", outputs.exit_point);
     unit("outputs.exit_normal", outputs.exit_normal);
   }
+  long geoms = 0;
   for (std::size_t i = 0; i < fixtures.size(); ++i) {
     const Fixture& f = fixtures[i];
     const std::string path = "fixtures[" + std::to_string(i) + "]";
     if (f.geoms.empty()) throw std::invalid_argument(path + ".geoms: a fixture needs a geom");
+    geoms += static_cast<long>(f.geoms.size());
+    if (geoms > limits::kMaxGeoms) {
+      throw std::invalid_argument(
+          path + ".geoms: " + std::to_string(geoms) + " fixture geoms up to this fixture; a " +
+          "scene holds at most " + std::to_string(limits::kMaxGeoms) +
+          " geoms (fixture geoms plus parts: ODE's hash space keeps an n x n bit matrix on the "
+          "stack)");
+    }
     for (std::size_t g = 0; g < f.geoms.size(); ++g) {
       const std::string gp = path + ".geoms[" + std::to_string(g) + "]";
       validateShape(gp, f.geoms[g].shape, true);
-      finite(gp + ".position", f.geoms[g].pose.position);
+      position(gp + ".position", f.geoms[g].pose.position);
       if (f.geoms[g].shape.kind == Shape::Kind::Plane && f.law.kind == FeederLaw::Kind::Vibration) {
         throw std::invalid_argument(gp + ".shape: a plane cannot vibrate (use a box)");
       }
@@ -193,18 +286,33 @@ void Scene::validate() const {
         break;
       case FeederLaw::Kind::Belt:
         unit(path + ".law.belt.direction", law.belt_direction);
-        finite(path + ".law.belt.speed", law.belt_speed);
+        within(path + ".law.belt.speed", law.belt_speed, -limits::kMaxSpeed, limits::kMaxSpeed,
+               "m/s");
         break;
       case FeederLaw::Kind::Vibration: {
         const Vibration& v = law.vibration;
-        nonNegative(path + ".law.vibration.amplitude", v.amplitude);
-        positive(path + ".law.vibration.frequency", v.frequency);
-        unit(path + ".law.vibration.direction", v.direction);
-        finite(path + ".law.vibration.phase", v.phase);
-        nonNegative(path + ".law.vibration.torsion_amplitude", v.torsion_amplitude);
-        finite(path + ".law.vibration.axis_origin", v.axis_origin);
-        unit(path + ".law.vibration.axis_direction", v.axis_direction);
-        if (v.isZero()) bad(path + ".law.vibration.amplitude", 0, "a vibration needs an amplitude");
+        const std::string vp = path + ".law.vibration";
+        within(vp + ".amplitude", v.amplitude, 0, limits::kMaxSize, "m");
+        positive(vp + ".frequency", v.frequency);
+        within(vp + ".frequency", v.frequency, 0, limits::kMaxFrequency, "Hz");
+        unit(vp + ".direction", v.direction);
+        finite(vp + ".phase", v.phase);
+        within(vp + ".torsion_amplitude", v.torsion_amplitude, 0, limits::kMaxTorsion, "rad");
+        position(vp + ".axis_origin", v.axis_origin);
+        unit(vp + ".axis_direction", v.axis_direction);
+        if (v.isZero()) bad(vp + ".amplitude", 0, "a vibration needs an amplitude");
+        const double omega = 2 * kPi * v.frequency;
+        if (omega * v.amplitude > limits::kMaxSpeed) {
+          bad(vp + ".amplitude", v.amplitude,
+              "peak speed 2 pi frequency amplitude = " + show(omega * v.amplitude) +
+                  " m/s must be <= " + show(limits::kMaxSpeed) + " m/s");
+        }
+        if (omega * v.torsion_amplitude > limits::kMaxAngularSpeed) {
+          bad(vp + ".torsion_amplitude", v.torsion_amplitude,
+              "peak angular speed 2 pi frequency torsion_amplitude = " +
+                  show(omega * v.torsion_amplitude) +
+                  " rad/s must be <= " + show(limits::kMaxAngularSpeed) + " rad/s");
+        }
         if (law.has_calibrated_drift)
           validateTwist(path + ".law.calibrated_drift", law.calibrated_drift);
         break;
@@ -221,22 +329,34 @@ void Scene::validate() const {
     if (p.shape == Shape::Kind::Mesh && p.mesh.empty())
       throw std::invalid_argument(path + ".mesh: empty file name");
     for (int d = 0; d < dims; ++d) {
-      const std::string sp = path + ".size[" + std::to_string(d) + "]";
-      positive(sp + ".mean", p.size[d].mean);
-      nonNegative(sp + ".stddev", p.size[d].stddev);
-      nonNegative(sp + ".min", p.size[d].min);
-      if (!(p.size[d].max > p.size[d].min)) bad(sp + ".max", p.size[d].max, "must exceed min");
+      validateDistribution(path + ".size[" + std::to_string(d) + "]", p.size[d],
+                           p.shape == Shape::Kind::Mesh);
     }
-    positive(path + ".density", p.density);
-    finite(path + ".spawn_min", p.spawn_min);
-    finite(path + ".spawn_max", p.spawn_max);
-    if (p.spawn_max.x < p.spawn_min.x || p.spawn_max.y < p.spawn_min.y ||
-        p.spawn_max.z < p.spawn_min.z) {
-      throw std::invalid_argument(path + ".spawn_max: must be >= spawn_min in every axis");
+    within(path + ".density", p.density, limits::kMinDensity, limits::kMaxDensity, "kg/m^3");
+    position(path + ".spawn_min", p.spawn_min);
+    position(path + ".spawn_max", p.spawn_max);
+    const double lo[3] = {p.spawn_min.x, p.spawn_min.y, p.spawn_min.z};
+    const double hi[3] = {p.spawn_max.x, p.spawn_max.y, p.spawn_max.z};
+    for (int k = 0; k < 3; ++k) {
+      if (hi[k] < lo[k]) {
+        bad(path + ".spawn_max." + "xyz"[k], hi[k],
+            "must be >= spawn_min." + std::string(1, "xyz"[k]) + " (" + show(lo[k]) + ")");
+      }
     }
-    if (p.count < 1) bad(path + ".count", p.count, "must be >= 1");
+    if (p.count < 1 || p.count > limits::kMaxGeoms) {
+      bad(path + ".count", p.count, "must be in [1, " + std::to_string(limits::kMaxGeoms) + "]");
+    }
+    geoms += p.count;
+    if (geoms > limits::kMaxGeoms) {
+      bad(path + ".count", p.count,
+          "brings the scene to " + std::to_string(geoms) +
+              " geoms (fixture geoms plus parts); "
+              "at most " +
+              std::to_string(limits::kMaxGeoms) +
+              " are allowed (ODE's hash space keeps an n x n bit matrix on the stack)");
+    }
     nonNegative(path + ".rate", p.rate);
-    finite(path + ".initial_velocity", p.initial_velocity);
+    magnitude(path + ".initial_velocity", p.initial_velocity, limits::kMaxSpeed, "m/s");
   }
 }
 
@@ -283,12 +403,15 @@ std::vector<PartInstance> drawParts(const Scene& scene) {
   std::mt19937_64 rng(scene.seed);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   std::normal_distribution<double> normal(0.0, 1.0);
-  auto draw = [&](const Distribution& d) {
+  // A size from d truncated to [min, max] and to [lo, hi] (the size limits of scene.hpp).
+  auto draw = [&](const Distribution& d, double lo = limits::kMinSize,
+                  double hi = limits::kMaxSize) {
+    const double a = std::max(d.min, lo), b = std::min(d.max, hi);
     for (int k = 0; k < kRedraws; ++k) {
       const double v = d.mean + d.stddev * normal(rng);
-      if (v >= d.min && v <= d.max && v > 0) return v;
+      if (v >= a && v <= b) return v;
     }
-    return std::min(std::max(d.mean, d.min), d.max);
+    return std::min(std::max(d.mean, a), b);
   };
   std::vector<PartInstance> out;
   std::vector<std::pair<Vec3, double>> placed;  // t = 0 parts: centre and bounding radius
@@ -305,6 +428,13 @@ std::vector<PartInstance> drawParts(const Scene& scene) {
       }
       unit_mesh = massProperties(*spec.mesh_data, spec.density);
       unit_radius = boundingRadius(*spec.mesh_data);
+      const double extent = spec.size[0].mean * unit_radius;
+      if (!(extent >= limits::kMinSize && extent <= limits::kMaxSize)) {
+        bad("parts[" + std::to_string(s) + "].size[0].mean", spec.size[0].mean,
+            "scales the mesh's bounding radius " + show(unit_radius) + " m to " + show(extent) +
+                " m, which must be in [" + show(limits::kMinSize) + ", " + show(limits::kMaxSize) +
+                "] m (mass and inertia must stay representable)");
+      }
     }
     for (int i = 0; i < spec.count; ++i) {
       PartInstance p;
@@ -337,7 +467,8 @@ std::vector<PartInstance> drawParts(const Scene& scene) {
           break;
         case Shape::Kind::Mesh: {
           // size[0] scales the mesh (centred on its centre of mass): m ~ s^3, I ~ s^5.
-          const double scale = draw(spec.size[0]);
+          const double scale =
+              draw(spec.size[0], limits::kMinSize / unit_radius, limits::kMaxSize / unit_radius);
           std::shared_ptr<const TriangleMesh>& mesh = scaled_meshes[scale];
           if (!mesh) mesh = std::make_shared<const TriangleMesh>(scaleMesh(*spec.mesh_data, scale));
           p.shape.mesh = spec.mesh;

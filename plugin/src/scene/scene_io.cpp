@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "rheofeed/scene/mesh.hpp"
+#include "scene_limits.hpp"
 
 namespace rheofeed::scene {
 namespace {
@@ -654,6 +655,40 @@ Scene readScene(const json& root) {
   fail(path, rest);
 }
 
+// A fixture mesh, scaled: its bounding box diagonal within the size limits and, placed at
+// `position`, every vertex within the coordinate limits (scene.hpp).
+void checkFixtureMesh(const TriangleMesh& mesh, const Vec3& position, const std::string& path) {
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (std::size_t v = 0; v + 2 < mesh.vertices.size(); v += 3) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], mesh.vertices[v + k]);
+      hi[k] = std::max(hi[k], mesh.vertices[v + k]);
+    }
+  }
+  const double diagonal = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  const std::string name = "mesh '" + mesh.source + "'";
+  auto range = [](double lo, double hi) {  // as Scene::validate writes its ranges
+    std::ostringstream out;
+    out << "[" << lo << ", " << hi << "] m";
+    return out.str();
+  };
+  if (!(diagonal >= limits::kMinSize && diagonal <= limits::kMaxSize)) {
+    fail(path, name + ": scaled bounding box diagonal " + show(diagonal) + " m must be in " +
+                   range(limits::kMinSize, limits::kMaxSize));
+  }
+  // The geom may be rotated: bound every vertex by the farthest one from the mesh origin.
+  const double reach = boundingRadius(mesh);
+  const double p[3] = {position.x, position.y, position.z};
+  for (int k = 0; k < 3; ++k) {
+    if (!(std::abs(p[k]) + reach <= limits::kMaxCoordinate)) {
+      fail(path, name + ": vertices reach " + show(std::abs(p[k]) + reach) +
+                     " m from the origin along " + std::string(1, "xyz"[k]) +
+                     "; coordinates must be in " +
+                     range(-limits::kMaxCoordinate, limits::kMaxCoordinate));
+    }
+  }
+}
+
 }  // namespace
 
 SceneFileError::SceneFileError(std::string source, std::string path, std::string problem, int line,
@@ -696,6 +731,7 @@ void loadSceneMeshes(Scene& scene, const fs::path& base_dir, const MeshLoader& m
       const std::string path =
           "fixtures[" + std::to_string(i) + "].geoms[" + std::to_string(g) + "].mesh";
       s.mesh_data = get(s.mesh, s.mesh_scale, path);
+      checkFixtureMesh(*s.mesh_data, scene.fixtures[i].geoms[g].pose.position, path);
     }
   }
   for (std::size_t i = 0; i < scene.parts.size(); ++i) {
@@ -734,12 +770,26 @@ Scene parseScene(const std::string& json_text, const std::string& source_name,
 }
 
 Scene loadScene(const fs::path& file, const MeshLoader& mesh_loader) {
+  // Kind and size first, from stat: a FIFO, a device or a directory is never opened.
+  const std::string problem = limits::regularFileProblem(file, limits::kMaxSceneFileBytes);
+  if (!problem.empty()) throw SceneFileError(file.string(), "", problem);
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw SceneFileError(file.string(), "", "cannot open the file");
-  std::ostringstream text;
-  text << in.rdbuf();
+  if (!in) throw SceneFileError(file.string(), "", "cannot open the file for reading");
+  // Read at most one byte past the cap: a file that grew since stat is still bounded.
+  std::error_code ec;
+  const std::uintmax_t expected = fs::file_size(file, ec);
+  std::string text(static_cast<std::size_t>(std::min(expected, limits::kMaxSceneFileBytes)) + 1,
+                   '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (in.bad()) throw SceneFileError(file.string(), "", "cannot read the file");
-  return parseScene(text.str(), file.string(), mesh_loader);
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > limits::kMaxSceneFileBytes) {
+    throw SceneFileError(file.string(), "",
+                         "the file grew beyond " + std::to_string(limits::kMaxSceneFileBytes) +
+                             " bytes while being read");
+  }
+  if (text.empty()) throw SceneFileError(file.string(), "", "the file is empty");
+  return parseScene(text, file.string(), mesh_loader);
 }
 
 }  // namespace rheofeed::scene

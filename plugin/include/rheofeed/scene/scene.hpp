@@ -7,6 +7,14 @@
 /// drawn from size distributions, spawned at t = 0 or at a flow rate), one material, solver
 /// settings and a duration. Units: SI (m, s, kg, m/s, rad/s, Hz); vectors in the world frame;
 /// gravity along -z unless the scene says otherwise.
+///
+/// Limits (Scene::validate; the reasons are in src/scene/scene_limits.hpp): every coordinate
+/// (geom positions, plane offsets, spawn bounds, axis origins, exit point, removal height) in
+/// [-1e6, 1e6] m (ODE's hash space breaks near 2.2e9 m); every size (box edges, radii, lengths,
+/// scaled mesh extents, size distributions) in [1e-5, 1e3] m and densities in [1e-3, 1e6] kg/m^3
+/// (mass and inertia stay normal doubles); speeds <= 1e3 m/s and angular speeds <= 1e4 rad/s
+/// (the contact's motion1 and fdir1 stay finite); at most 4096 geoms (fixture geoms plus
+/// parts: ODE's hash space keeps an n x n bit matrix on the stack).
 #pragma once
 
 #include <cstdint>
@@ -30,14 +38,17 @@ struct TriangleMesh {
 struct Shape {
   enum class Kind { Box, Sphere, Cylinder, Capsule, Plane, Mesh };
   Kind kind = Kind::Box;
-  Vec3 size{0.1, 0.1, 0.1};  ///< Box: edge lengths (m)
-  double radius = 0.05;      ///< Sphere, Cylinder, Capsule (m)
-  double length = 0.1;       ///< Cylinder, Capsule: length along local z (m)
-  /// Plane: unit normal (world) and offset d (m): points p with normal . p = d. Static only.
+  Vec3 size{0.1, 0.1, 0.1};  ///< Box: edge lengths (m, each in [1e-5, 1e3])
+  double radius = 0.05;      ///< Sphere, Cylinder, Capsule (m, in [1e-5, 1e3])
+  double length = 0.1;       ///< Cylinder, Capsule: length along local z (m, in [1e-5, 1e3])
+  /// Plane: unit normal (world) and offset d (m, in [-1e6, 1e6]): points p with
+  /// normal . p = d. Static only.
   Vec3 plane_normal{0, 0, 1};
   double plane_offset = 0;
-  std::string mesh;         ///< Mesh: file path (any format assimp reads)
-  double mesh_scale = 1.0;  ///< Mesh: scale applied to the file's coordinates
+  std::string mesh;  ///< Mesh: file path (any format assimp reads)
+  /// Mesh: scale applied to the file's coordinates (> 0); the scaled mesh must span
+  /// [1e-5, 1e3] m and stay within [-1e6, 1e6] m once placed.
+  double mesh_scale = 1.0;
   /// Mesh: the loaded triangles (already scaled), filled by the scene loader (scene_io.hpp);
   /// geoms are built from it, so a scene without meshes never loads any.
   std::shared_ptr<const TriangleMesh> mesh_data;
@@ -51,12 +62,16 @@ const char* toString(Shape::Kind kind);
 ///   theta(t) = torsion_amplitude sin(2 pi frequency t + phase)          (rad, about the axis)
 /// A screw motion (bowl feeders) has both: vertical translation along the axis and torsion.
 struct Vibration {
-  double amplitude = 0;          ///< peak displacement (m), not peak-to-peak
-  double frequency = 0;          ///< (Hz)
-  Vec3 direction{1, 0, 0};       ///< unit translation direction (world)
-  double phase = 0;              ///< (rad)
-  double torsion_amplitude = 0;  ///< peak rotation about the axis (rad)
-  Vec3 axis_origin{0, 0, 0};     ///< a point of the torsion axis (m)
+  /// Peak displacement (m, in [0, 1e3], not peak-to-peak); peak speed 2 pi frequency
+  /// amplitude <= 1e3 m/s.
+  double amplitude = 0;
+  double frequency = 0;     ///< (Hz, in (0, 1e5])
+  Vec3 direction{1, 0, 0};  ///< unit translation direction (world)
+  double phase = 0;         ///< (rad, finite)
+  /// Peak rotation about the axis (rad, in [0, pi]); peak angular speed 2 pi frequency
+  /// torsion_amplitude <= 1e4 rad/s. Amplitude or torsion amplitude must be > 0.
+  double torsion_amplitude = 0;
+  Vec3 axis_origin{0, 0, 0};  ///< a point of the torsion axis (m, each coordinate in [-1e6, 1e6])
   Vec3 axis_direction{0, 0, 1};  ///< unit torsion axis
   /// Pose of the vibrating feeder at time t relative to its rest pose (apply to the rest pose).
   Pose displacement(double t) const;
@@ -72,12 +87,14 @@ struct FeederLaw {
     Vibration,  ///< a real vibration; rheonomic methods use its calibrated drift field
   };
   Kind kind = Kind::None;
-  Twist drift;  ///< Drift: v (m/s), w (rad/s) about origin (m), world frame
+  /// Drift: v (m/s, |v| <= 1e3), w (rad/s, |w| <= 1e4) about origin (m, in [-1e6, 1e6]),
+  /// world frame.
+  Twist drift;
   Vec3 belt_direction{1, 0, 0};
-  double belt_speed = 0;  ///< (m/s)
+  double belt_speed = 0;  ///< (m/s, in [-1e3, 1e3])
   Vibration vibration;    ///< Vibration
   /// Vibration: the drift field that replaces it in rheonomic runs (from calibration). Set by
-  /// the calibration step or given by the scene ("vibration, calibrated").
+  /// the calibration step or given by the scene ("vibration, calibrated"); limits as drift.
   bool has_calibrated_drift = false;
   Twist calibrated_drift;
 };
@@ -94,7 +111,10 @@ struct Fixture {
   FeederLaw law;
 };
 
-/// A normally distributed size, truncated to [min, max] (m).
+/// A normally distributed size, truncated to [min, max] and to the size limits [1e-5, 1e3] m
+/// (m; for a mesh part the scale factor, truncated so that the scaled mesh stays within the
+/// size limits). Requires 0 <= min <= mean <= max, stddev >= 0 (<= 1e3 m for a size) and the
+/// mean within the size limits (a mesh part: mean times the mesh's bounding radius).
 struct Distribution {
   double mean = 0.01;
   double stddev = 0;
@@ -114,38 +134,42 @@ struct PartSpec {
   std::string mesh;      ///< Mesh parts: file (assimp); size[0] is the scale factor
   /// Mesh parts: loaded triangles at scale 1, centred on their centre of mass (scene loader).
   std::shared_ptr<const TriangleMesh> mesh_data;
-  double density = 7800;      ///< (kg/m^3)
-  Vec3 spawn_min, spawn_max;  ///< spawn region, axis-aligned box (m, world)
+  double density = 7800;  ///< (kg/m^3, in [1e-3, 1e6])
+  /// Spawn region, axis-aligned box (m, world; coordinates in [-1e6, 1e6], spawn_min <=
+  /// spawn_max per axis).
+  Vec3 spawn_min, spawn_max;
   bool random_orientation = false;
-  int count = 1;          ///< total number of parts
-  double rate = 0;        ///< parts per second; 0: all at t = 0
-  Vec3 initial_velocity;  ///< (m/s)
+  /// Total number of parts (>= 1); all counts plus the fixture geoms at most 4096.
+  int count = 1;
+  double rate = 0;        ///< parts per second (finite, >= 0); 0: all at t = 0
+  Vec3 initial_velocity;  ///< (m/s, |v| <= 1e3)
 };
 
 /// Contact material (one for all pairs).
 struct Material {
-  double mu = 0.5;           ///< friction coefficient (>= 0)
-  double restitution = 0.0;  ///< (0..1)
+  double mu = 0.5;           ///< friction coefficient (in [0, 10])
+  double restitution = 0.0;  ///< (in [0, 1])
 };
 
 /// The dynamics engine and its settings.
 struct SolverSettings {
-  double time_step = 0.01;    ///< (s)
-  int iterations = 50;        ///< ODE quickstep iterations or CCP iteration budget
+  /// (s, in [1e-6, 1], <= Scene::duration; duration / time_step <= 1e9 steps)
+  double time_step = 0.01;
+  int iterations = 50;        ///< ODE quickstep iterations or CCP iteration budget ([1, 1e6])
   bool ode_quickstep = true;  ///< ODE: dWorldQuickStep (true) or dWorldStep (Dantzig)
-  double erp = 0.2;           ///< ODE and reference
-  double cfm = 1e-5;          ///< ODE and reference (ODE's units)
-  double tolerance = 1e-6;    ///< CCP residual tolerance
+  double erp = 0.2;           ///< ODE and reference (in [0, 1])
+  double cfm = 1e-5;          ///< ODE and reference (ODE's units, finite, >= 0)
+  double tolerance = 1e-6;    ///< CCP residual tolerance (finite, > 0)
   bool apgd = true;           ///< CCP: APGD (true) or PGS
-  /// Reference solver: outer fixed-point iterations of the true Coulomb law (>= 0). 0 solves
+  /// Reference solver: outer fixed-point iterations of the true Coulomb law ([0, 1e6]). 0 solves
   /// the relaxed CCP, whose sliding contacts separate at mu |u_t| (parts hop off a sliding
   /// surface: +16 % slip at 400 steps per cycle on a vibrated plate, tests/reference).
   int coulomb_iterations = 10;
-  /// Cap on the speed at which a penetration is pushed out (m/s, > 0), ODE's
+  /// Cap on the speed at which a penetration is pushed out (m/s, in (0, 1e3]), ODE's
   /// dWorldSetContactMaxCorrectingVel, mirrored by the reference. Without it ERP depth / h
   /// becomes a launch speed at small h (0.2 x 5 mm / 0.1 ms = 10 m/s).
   double max_correcting_velocity = 0.5;
-  /// Penetration depth (m, >= 0) left uncorrected by ERP, ODE's
+  /// Penetration depth (m, in [0, 1e3]) left uncorrected by ERP, ODE's
   /// dWorldSetContactSurfaceLayer, mirrored by the reference. Without it every landing on a
   /// vibrating surface is followed by an ERP push that can lock a part into a chattering
   /// orbit of its own (parts at 0.26x or 1.3x the drift of their neighbours, depending on ERP;
@@ -169,30 +193,36 @@ struct Outputs {
   /// Measure the drift as an angular velocity (rad/s) about an axis (bowls, turntables)
   /// instead of a velocity along conveying_direction.
   bool angular_drift = false;
-  Vec3 axis_origin{0, 0, 0};     ///< a point of the drift axis (m)
+  Vec3 axis_origin{0, 0, 0};     ///< a point of the drift axis (m, in [-1e6, 1e6])
   Vec3 axis_direction{0, 0, 1};  ///< unit drift axis; positive drift turns by the right hand
   bool exit_plane = false;       ///< count parts crossing the plane
-  Vec3 exit_point, exit_normal{1, 0, 0};
-  double sample_interval = 0.01;  ///< (s) metric sampling period
-  double warmup = 0.0;            ///< (s) excluded from the mean drift
+  Vec3 exit_point;               ///< a point of the exit plane (m, in [-1e6, 1e6])
+  Vec3 exit_normal{1, 0, 0};     ///< unit normal of the exit plane, pointing out
+  /// (s) metric sampling period, in (0, duration]: a run must take at least one sample.
+  double sample_interval = 0.01;
+  /// (s) excluded from the mean drift, in [0, duration - time_step]: a drift must be
+  /// measured after it.
+  double warmup = 0.0;
 };
 
 struct Scene {
   std::string name = "scene";
-  Vec3 gravity{0, 0, -9.81};
+  Vec3 gravity{0, 0, -9.81};  ///< (m/s^2, world, |g| <= 1e3)
   std::vector<Fixture> fixtures;
   std::vector<PartSpec> parts;
   Material material;
   SolverSettings solver;
   /// Parts that fall below this height (m) have left the scene: they are removed from the
-  /// simulation (no more contacts or motion) and from the drift metrics.
+  /// simulation (no more contacts or motion) and from the drift metrics. In [-1e6, 1e6].
   double removal_height = -2.0;
-  double duration = 1.0;  ///< (s)
+  /// (s, >= solver.time_step; duration / time_step <= 1e9 steps)
+  double duration = 1.0;
   std::uint64_t seed = 1;
   Outputs outputs;
 
-  /// Throws std::invalid_argument naming the path of the first bad value
-  /// (e.g. "parts[0].size[1].mean = -1: must be > 0").
+  /// Throws std::invalid_argument naming the path of the first bad value, the value and the
+  /// allowed range (e.g. "parts[0].density = 1e+300: must be a finite number in [0.001, 1e+06]
+  /// kg/m^3"): every limit stated on the fields above.
   void validate() const;
   bool hasMeshes() const;
   bool hasVibration() const;

@@ -50,7 +50,12 @@ using MeshLoader = std::function<TriangleMesh(const std::filesystem::path& file,
 
 /// Reads, checks and returns the scene in `file`. Relative mesh paths are resolved against the
 /// folder of `file` and stored as absolute paths. `mesh_loader` empty means loadTriangleMesh.
-/// Throws SceneFileError (also for a file that cannot be read and for bad meshes).
+/// Only a regular file (symbolic links followed) of 1 byte to 16 MiB is read: a missing file,
+/// a directory, a FIFO, a socket or a device (checked with stat, never opened), an empty file
+/// and a larger one are refused before anything is read (scene files are hand-written
+/// parameters, 12 KB for the largest demo; the cap bounds the JSON DOM). Throws
+/// SceneFileError naming the file (and the JSON path of a bad value) for all of these, for a
+/// file that cannot be read, for bad values (limits: scene.hpp) and for bad meshes.
 Scene loadScene(const std::filesystem::path& file, const MeshLoader& mesh_loader = {});
 
 /// As loadScene, from the text `json_text`; `source_name` names it in messages and its parent
