@@ -318,14 +318,8 @@ Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n) const {
       return tangentialPart(v_, n);
     case Eval::Twist:
       return tangentialPart(v_ + cross(w_, p - o_), n);
-    case Eval::Secant: {
-      const Vec3 r = p - o_;
-      const double* m = m_;
-      const Vec3 c{m[0] * r.x + m[1] * r.y + m[2] * r.z + d_.x,
-                   m[3] * r.x + m[4] * r.y + m[5] * r.z + d_.y,
-                   m[6] * r.x + m[7] * r.y + m[8] * r.z + d_.z};
-      return tangentialPart(c, n);
-    }
+    case Eval::Secant:
+      return tangentialPart(secant(p), n);
     case Eval::Belt: {
       const Vec3 along = tangentialPart(v_, n);
       const double length = norm(along);
@@ -339,6 +333,19 @@ Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n) const {
     }
   }
   return {};
+}
+
+Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n, const Vec3& carried) const {
+  if (eval_ != Eval::Secant) return tangentialVelocity(p, n);
+  // The rigid motion that takes the carried point along its secant and turns at w.
+  return tangentialPart(secant(carried) + cross(w_, p - carried), n);
+}
+
+Vec3 StepLaw::secant(const Vec3& p) const {
+  const Vec3 r = p - o_;
+  const double* m = m_;
+  return {m[0] * r.x + m[1] * r.y + m[2] * r.z + d_.x, m[3] * r.x + m[4] * r.y + m[5] * r.z + d_.y,
+          m[6] * r.x + m[7] * r.y + m[8] * r.z + d_.z};
 }
 
 bool StepLaw::sameMotionAs(const StepLaw& other) const {

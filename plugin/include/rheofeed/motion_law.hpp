@@ -184,6 +184,15 @@ class StepLaw {
   /// non-finite value (then `isFinite` of the result is false and the caller leaves the contact
   /// undriven).
   Vec3 tangentialVelocity(const Vec3& p, const Vec3& n) const;
+  /// The same for a contact of a rigid part whose centre of mass is at `carried` (m, world, at
+  /// the start of the step): for a secant law, the velocity at `p` of the rigid motion that
+  /// carries the centre of mass along its secant and turns the part at w,
+  /// c = secant(carried) + w x (p - carried). A part sticking to a turntable then has its
+  /// centre of mass land exactly on the rotated point, and every one of its contacts asks for
+  /// the same rigid motion (the secants of the contact points themselves differ from a rigid
+  /// field by -(1 - cos(w h)) / h times their in-plane spread, which no rigid part can follow).
+  /// Equal to the two-argument form for every other law, and for carried = p.
+  Vec3 tangentialVelocity(const Vec3& p, const Vec3& n, const Vec3& carried) const;
 
   /// Whether the frozen values are all finite (a profile or twist function can fail).
   bool finite() const { return finite_; }
@@ -199,6 +208,8 @@ class StepLaw {
   enum class Eval { Zero, Translation, Twist, Secant, Belt, Field };
   // Turns a Twist (w != 0) into its secant over a step of h > 0 seconds: c = M (p - O) + d.
   void freezeSecant(double h);
+  // The (untruncated) secant velocity at p: M (p - O) + d.
+  Vec3 secant(const Vec3& p) const;
 
   Eval eval_ = Eval::Zero;
   Vec3 v_, w_, o_;     // world frame; Belt: v_ = unit direction, w_.x = speed
