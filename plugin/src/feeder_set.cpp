@@ -337,10 +337,11 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
         ++f->stats.law_not_finite;
         s.report(*f, DiagnosticKind::LawNotFinite, law.problem() + "; contact left undriven");
       } else {
-        // The surface carries the body on the other side of the contact (secant laws).
+        // A secant law carries the body on the other side of the contact rigidly.
         const dBodyID carried = f == f_first ? b_second : b_first;
-        value = carried ? law.tangentialVelocity(p, n, toVec3(dBodyGetPosition(carried)))
-                        : law.tangentialVelocity(p, n);
+        value = carried && law.usesCarriedPoint()
+                    ? law.tangentialVelocity(p, n, toVec3(dBodyGetPosition(carried)))
+                    : law.tangentialVelocity(p, n);
         if (!isFinite(value)) {
           finite = false;
           ++f->stats.law_not_finite;

@@ -202,6 +202,9 @@ int main(void) {
     const double w_axis[3] = {0, 0, 1};
     const double h = 0.1, r = 0.1;
     CHECK(rfFeederSetAddTwist(set, table_geom, zero, w_axis, zero, rfFrameWorld) == rfOK);
+    /* The part's centre of mass right above the contact point: the part is carried rigidly
+     * along its centre of mass's chord, which is then the contact point's chord. */
+    dBodySetPosition(part, r, 0, 0.05);
     for (step = 0; step < 2; ++step) {
       if (step == 0) {
         CHECK(rfFeederSetBeginStepDt(set, 0.0, h) == rfOK);

@@ -146,6 +146,8 @@ constexpr double kLongRadius = 0.1;   // m, initial distance of the box's centre
 // Sticking needs m w^2 r <= mu m g: w^2 r = 2.5 m/s^2 at w = 5 rad/s, r = 0.1 m.
 constexpr double kLongMu = 1.0;
 // The requirement for a sticking part: radius constant to 1e-6 relative over 60 s.
+// What remains is CFM's creep: the four contacts share the centripetal force m w^2 r and each
+// slips outwards at cfm m w^2 r / 4, r0 cfm m w^2 t / 4 = 3.75e-8 r0 at w = 5 rad/s (measured).
 constexpr double kRadiusTolerance = 1e-6;  // relative
 // dWorldStep solves each LCP exactly up to CFM 1e-9 (tests/support/ode_world.hpp): the same
 // budget as the radius for the arc, 1e-6 r.

@@ -21,8 +21,10 @@
 /// outwards by sqrt(1 + (w h)^2) per step.
 ///
 /// ## What a driven contact gets
-/// With c_F the tangential surface velocity (motion_law.hpp) of a feeder geom F at the contact,
-/// and c = 0 for a geom that is no feeder, the contact between geoms g1 and g2 asks that the
+/// With c_F the tangential surface velocity (motion_law.hpp) of a feeder geom F at the contact
+/// (for a rotating law given the step: the secant that carries the other geom's body, whose
+/// position is its centre of mass, rigidly with the surface), and c = 0 for a geom that is no
+/// feeder, the contact between geoms g1 and g2 asks that the
 /// material points in contact move together: (v_g1 + c_g1) - (v_g2 + c_g2) has no tangential
 /// part, where v is the velocity of the geom's body at the contact point (0 for a static geom).
 /// ODE's friction row 1 enforces (v_node0 - v_node1) . fdir1 = motion1, where node0 is the

@@ -31,10 +31,15 @@
 ///
 ///     c = v_par + (R(w h) - I) (p - O') / h                  (-> v + w x (p - O) as h -> 0)
 ///
-/// and a part carried at `c` lands exactly on the rotated (for a screw: helical) point. The
-/// tangential part is taken as above. Always pass the step your integrator takes; step = 0 keeps
-/// the instantaneous field (bitwise as before issue 7), and its outward drift. Translations,
-/// belts and fields do not depend on the step.
+/// and a point carried at `c` lands exactly on the rotated (for a screw: helical) point. The
+/// tangential part is taken as above. These point secants are not a rigid field (they contract
+/// towards the axis at (1 - cos(|w| h)) / h times the distance to it), so the contacts of one part
+/// would ask for incompatible motions; FeederSet and the reference world therefore give every
+/// contact of a part with centre of mass x_c the rigid motion `c(x_c) + w x (p - x_c)`, which lands
+/// x_c on its rotated point and turns the part at w (StepLaw::tangentialVelocity with `carried`).
+/// Always pass the step your integrator takes; step = 0 keeps the instantaneous field (bitwise as
+/// before issue 7), and its outward drift. Translations, belts and fields do not depend on the
+/// step.
 ///
 /// All vectors are in metres, m/s and rad/s; "world" means the ODE world frame, "body" means the
 /// frame of the body that carries the feeder geom (the law then follows the body).
@@ -193,6 +198,9 @@ class StepLaw {
   /// field by -(1 - cos(w h)) / h times their in-plane spread, which no rigid part can follow).
   /// Equal to the two-argument form for every other law, and for carried = p.
   Vec3 tangentialVelocity(const Vec3& p, const Vec3& n, const Vec3& carried) const;
+  /// True if `carried` changes tangentialVelocity (a secant law): callers may skip looking up
+  /// the carried body otherwise.
+  bool usesCarriedPoint() const { return eval_ == Eval::Secant; }
 
   /// Whether the frozen values are all finite (a profile or twist function can fail).
   bool finite() const { return finite_; }
