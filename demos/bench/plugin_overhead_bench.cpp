@@ -7,7 +7,10 @@
 //    itself registered as a feeder, so every ground contact is driven.
 //    Goal: (b) / (a) within 2 %.
 // 2. Cost of driveContacts per contact for a non-feeder contact and per driven feeder contact
-//    with each kind of law.
+//    with each kind of law; a twist with the step given (the secant: a 3 x 3 matrix times a
+//    vector per contact) against the static environment and against a part on a body (the
+//    secant of the body's centre of mass plus w x (p - x_c)), and the instantaneous twist
+//    against a part on a body for comparison.
 //
 // Each pile repetition builds a fresh, identical scene and times the same fixed number of steps,
 // so (a), (b) and (c) see identical work; repetitions are randomly interleaved. The program ends
@@ -152,8 +155,22 @@ void BM_DriveContacts(benchmark::State& state) {
                 return rheofeed::Vec3{-p.y, p.x, 0};
               }));
       break;
+    case 6:
+    case 7:
+    case 8:
+      set.add(feeder, MotionLaw::rotation({0, 0, 1}, {0, 0, 0}));
+      break;
     default:
       break;
+  }
+  // Laws 6 and 7 freeze with the step (the secant), 8 without; 7 and 8 carry a part on a body.
+  const double step = kind == 6 || kind == 7 ? 1e-3 : 0.0;
+  dWorldID world = nullptr;
+  if (kind == 7 || kind == 8) {
+    world = dWorldCreate();
+    dBodyID body = dBodyCreate(world);
+    dBodySetPosition(body, 0.3, 0.5, 0.02);
+    dGeomSetBody(part, body);
   }
   constexpr int kCount = 64;
   std::vector<dContact> tmpl(kCount), work(kCount);
@@ -172,7 +189,7 @@ void BM_DriveContacts(benchmark::State& state) {
   for (auto _ : state) {
     std::memcpy(work.data(), tmpl.data(), sizeof(dContact) * kCount);
     if (kind > 0) {
-      set.beginStep(t += 1e-3);
+      set.beginStep(t += 1e-3, step);
       benchmark::DoNotOptimize(set.driveContacts(work.data(), kCount));
     }
     benchmark::ClobberMemory();
@@ -180,10 +197,11 @@ void BM_DriveContacts(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * kCount);
   dGeomDestroy(feeder);
   dGeomDestroy(part);
+  if (world) dWorldDestroy(world);
 }
 BENCHMARK(BM_DriveContacts)
     ->ArgName("law")
-    ->DenseRange(0, 5)
+    ->DenseRange(0, 8)
     ->Repetitions(5)
     ->ReportAggregatesOnly(true);
 
@@ -244,8 +262,16 @@ int main(int argc, char** argv) {
         ground / plain);
   }
   const double copy = get("BM_DriveContacts/law:0");
-  const char* names[] = {"", "no-feeder contact", "belt", "translation", "twist", "field"};
-  for (int k = 1; k <= 5; ++k) {
+  const char* names[] = {"",
+                         "no-feeder contact",
+                         "belt",
+                         "translation",
+                         "twist",
+                         "field",
+                         "twist secant (step given)",
+                         "twist secant carrying a body",
+                         "twist without step, part on a body"};
+  for (int k = 1; k <= 8; ++k) {
     const double t = get("BM_DriveContacts/law:" + std::to_string(k));
     if (t > 0 && copy >= 0) {
       std::printf("| driveContacts per %s contact (ns) | %.2f |\n", names[k], (t - copy) / 64.0);

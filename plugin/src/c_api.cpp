@@ -159,6 +159,10 @@ int rfFeederSetBeginStep(rfFeederSetID set, double time) {
   return guarded(set, [&] { set->set.beginStep(time); });
 }
 
+int rfFeederSetBeginStepDt(rfFeederSetID set, double time, double step) {
+  return guarded(set, [&] { set->set.beginStep(time, step); });
+}
+
 int rfFeederSetDriveContacts(rfFeederSetID set, dContact* contacts, int count) {
   if (!set) return rfErrorInvalidArgument;
   return set->set.driveContacts(contacts, count);

@@ -37,8 +37,8 @@ void ContactCollider::clearJoints() {
 }
 
 void ContactCollider::collide(dSpaceID space, double time, double step) {
+  feeders_.beginStep(time, step);  // first: a refused time or step leaves everything as it was
   clearJoints();
-  feeders_.beginStep(time, step);
   collideWithin(space);
 }
 

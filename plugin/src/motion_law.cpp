@@ -13,6 +13,11 @@ namespace {
 // to the contact plane: the contact is on an end face, which does not move along the surface.
 constexpr double kBeltEdgeCosine = 1e-6;
 
+// Below this turn per step (rad) the secant's coefficients sin(theta)/theta and
+// (1 - cos(theta))/theta^2 are taken from their Taylor series (then exact to double rounding,
+// and free of 0/0 when |w| h underflows).
+constexpr double kSeriesAngle = 1e-4;
+
 [[noreturn]] void refuse(const std::string& where, const std::string& what, double value,
                          const std::string& why) {
   std::ostringstream out;
@@ -207,9 +212,15 @@ void MotionLaw::validate(const std::string& where) const {
 }
 
 StepLaw MotionLaw::evaluate(double t, const Pose* body_pose, double step) const {
-  (void)step;  // TODO(issue 7): secant surface velocity of rotating twists
   StepLaw s;
   s.time_ = t;
+  if (!(step >= 0.0) || !std::isfinite(step)) {
+    s.finite_ = false;
+    std::ostringstream out;
+    out << "step = " << step << " s is not finite and >= 0";
+    s.problem_ = out.str();
+    return s;
+  }
   s.scale_ = profile_(t);
   if (!std::isfinite(s.scale_)) {
     s.finite_ = false;
@@ -247,6 +258,8 @@ StepLaw MotionLaw::evaluate(double t, const Pose* body_pose, double step) const 
   s.o_ = body ? body_pose->transform(tw.origin) : tw.origin;
   if (isZero(w)) {
     s.eval_ = isZero(v) ? StepLaw::Eval::Zero : StepLaw::Eval::Translation;
+  } else if (step > 0.0) {
+    s.freezeSecant(step);
   } else {
     s.eval_ = StepLaw::Eval::Twist;
   }
@@ -256,6 +269,47 @@ StepLaw MotionLaw::evaluate(double t, const Pose* body_pose, double step) const 
 // ---------------------------------------------------------------------------------------------
 // StepLaw
 
+// The secant of a twist over a step (see the derivation in motion_law.hpp). With w = |w| u,
+// theta = |w| h and K = [w]x (K p = w x p), Rodrigues gives
+//   R(w h) - I = sin(theta) [u]x + (1 - cos(theta)) [u]x^2
+//   M = (R - I) / h = a K + b h K^2,  a = sin(theta) / theta,  b = (1 - cos(theta)) / theta^2,
+// with K^2 = w w^T - |w|^2 I. The flow of v_par + w x (p - O') with O' = O + (w x v) / |w|^2
+// moves p by h c(p), c(p) = v_par + M (p - O'). Since M (w x v) / |w|^2 = -a v_perp - b h (w x v)
+// (from K (w x v) = -|w|^2 v_perp and K^2 (w x v) = -|w|^2 (w x v)), the same c is
+//   c(p) = M (p - O) + d,   d = v_par + a v_perp + b h (w x v),
+// which needs no division by |w|^2 (O' runs off to infinity as w -> 0) and keeps p - O small.
+// As h -> 0, a -> 1 and b h -> 0: M -> K and d -> v, the instantaneous field v + w x (p - O).
+void StepLaw::freezeSecant(double h) {
+  const double speed = norm(w_);
+  const double theta = speed * h;
+  double a, b;
+  if (theta < kSeriesAngle) {
+    // Taylor series; the first omitted terms, theta^4 / 120 and theta^4 / 720, are below
+    // double rounding for theta < kSeriesAngle.
+    a = 1.0 - theta * theta / 6.0;
+    b = 0.5 - theta * theta / 24.0;
+  } else {
+    a = std::sin(theta) / theta;
+    const double half = std::sin(0.5 * theta) / (0.5 * theta);
+    b = 0.5 * half * half;  // (1 - cos(theta)) / theta^2 without cancellation
+  }
+  const double ww[3] = {w_.x, w_.y, w_.z};
+  const double w2 = dot(w_, w_);
+  const double bh = b * h;
+  // M = a K + b h (w w^T - |w|^2 I), row-major.
+  const double k[9] = {0, -w_.z, w_.y, w_.z, 0, -w_.x, -w_.y, w_.x, 0};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      m_[3 * i + j] = a * k[3 * i + j] + bh * (ww[i] * ww[j] - (i == j ? w2 : 0.0));
+    }
+  }
+  const Vec3 u = (1.0 / speed) * w_;
+  const Vec3 v_par = dot(v_, u) * u;
+  d_ = v_par + a * (v_ - v_par) + bh * cross(w_, v_);
+  step_ = h;
+  eval_ = Eval::Secant;
+}
+
 Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n) const {
   switch (eval_) {
     case Eval::Zero:
@@ -264,6 +318,8 @@ Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n) const {
       return tangentialPart(v_, n);
     case Eval::Twist:
       return tangentialPart(v_ + cross(w_, p - o_), n);
+    case Eval::Secant:
+      return tangentialPart(secant(p), n);
     case Eval::Belt: {
       const Vec3 along = tangentialPart(v_, n);
       const double length = norm(along);
@@ -279,6 +335,19 @@ Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n) const {
   return {};
 }
 
+Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n, const Vec3& carried) const {
+  if (eval_ != Eval::Secant) return tangentialVelocity(p, n);
+  // The rigid motion that takes the carried point along its secant and turns at w.
+  return tangentialPart(secant(carried) + cross(w_, p - carried), n);
+}
+
+Vec3 StepLaw::secant(const Vec3& p) const {
+  const Vec3 r = p - o_;
+  const double* m = m_;
+  return {m[0] * r.x + m[1] * r.y + m[2] * r.z + d_.x, m[3] * r.x + m[4] * r.y + m[5] * r.z + d_.y,
+          m[6] * r.x + m[7] * r.y + m[8] * r.z + d_.z};
+}
+
 bool StepLaw::sameMotionAs(const StepLaw& other) const {
   if (eval_ != other.eval_) return false;
   switch (eval_) {
@@ -286,8 +355,8 @@ bool StepLaw::sameMotionAs(const StepLaw& other) const {
       return true;
     case Eval::Field:
       return field_ == other.field_ && scale_ == other.scale_ && !time_varying_field_;
-    default:
-      return v_ == other.v_ && w_ == other.w_ && o_ == other.o_;
+    default:  // a secant also depends on the step length
+      return v_ == other.v_ && w_ == other.w_ && o_ == other.o_ && step_ == other.step_;
   }
 }
 

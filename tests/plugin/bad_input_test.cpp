@@ -233,6 +233,16 @@ TEST_F(BadInput, NonFiniteStepTimeIsRefused) {
   EXPECT_EQ(set_.time(), 2.5);
 }
 
+TEST_F(BadInput, NegativeOrNonFiniteStepLengthIsRefusedAndChangesNothing) {
+  set_.beginStep(1.0, 0.01);
+  expectMentions(refusal([&] { set_.beginStep(2.0, -0.01); }), {"beginStep", "step = -0.01"});
+  expectMentions(refusal([&] { set_.beginStep(2.0, kNan); }), {"beginStep", "step = nan"});
+  expectMentions(refusal([&] { set_.beginStep(2.0, kInf); }), {"beginStep", "step = inf"});
+  EXPECT_EQ(set_.time(), 1.0);
+  set_.beginStep(2.0, 0.0);  // 0: the instantaneous field
+  EXPECT_EQ(set_.time(), 2.0);
+}
+
 TEST(BadOptions, MinSurfaceSpeedMustBeFiniteAndNonNegative) {
   for (double bad : {kNan, -1e-9, kInf}) {
     FeederSet::Options options;

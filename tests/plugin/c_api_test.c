@@ -77,7 +77,7 @@ int main(void) {
   const double zero[3] = {0, 0, 0};
   dWorldID world;
   dJointGroupID joints;
-  dGeomID belt, part_geom, other, field_geom;
+  dGeomID belt, part_geom, other, field_geom, table_geom;
   dBodyID part;
   dMass mass;
   dContact contacts[8];
@@ -100,6 +100,7 @@ int main(void) {
   dGeomSetBody(part_geom, part);
   other = dCreateBox(0, 1, 1, 1);
   field_geom = dCreateBox(0, 1, 1, 1);
+  table_geom = dCreateBox(0, 1, 1, 1);
 
   set = rfFeederSetCreate();
   CHECK(set != 0);
@@ -193,6 +194,47 @@ int main(void) {
   CHECK(field_calls == 3);
   CHECK_NEAR(contacts[0].surface.motion1 * contacts[0].fdir1[1], 0.2, ROUND_OFF);
 
+  /* A turntable (w = 1 rad/s about +z through the origin) with the step given: a contact at
+   * p = (r, 0, 0) is driven at the chord to the point turned by w h, (R(w h) p - p) / h =
+   * r (cos(w h) - 1, sin(w h), 0) / h, so that the part lands on its circle; without the step
+   * at the tangent w x p = (0, w r, 0). h = 0.1 s makes the two differ by 5e-4 m/s. */
+  {
+    const double w_axis[3] = {0, 0, 1};
+    const double h = 0.1, r = 0.1;
+    CHECK(rfFeederSetAddTwist(set, table_geom, zero, w_axis, zero, rfFrameWorld) == rfOK);
+    /* The part's centre of mass right above the contact point: the part is carried rigidly
+     * along its centre of mass's chord, which is then the contact point's chord. */
+    dBodySetPosition(part, r, 0, 0.05);
+    for (step = 0; step < 2; ++step) {
+      if (step == 0) {
+        CHECK(rfFeederSetBeginStepDt(set, 0.0, h) == rfOK);
+      } else {
+        CHECK(rfFeederSetBeginStep(set, 0.0) == rfOK);
+      }
+      memset(contacts, 0, sizeof contacts);
+      contacts[0].geom.g1 = table_geom;
+      contacts[0].geom.g2 = part_geom;
+      contacts[0].geom.pos[0] = r;
+      contacts[0].geom.normal[2] = 1.0;
+      contacts[0].surface.mu = 0.5;
+      CHECK(rfFeederSetDriveContacts(set, contacts, 1) == 1);
+      /* The part's body is the joint's first body (the table is static): c_rel = c_table. */
+      CHECK_NEAR(contacts[0].surface.motion1 * contacts[0].fdir1[0],
+                 step == 0 ? r * (cos(h) - 1.0) / h : 0.0, ROUND_OFF);
+      CHECK_NEAR(contacts[0].surface.motion1 * contacts[0].fdir1[1], step == 0 ? r * sin(h) / h : r,
+                 ROUND_OFF);
+    }
+    /* A bad step is refused with its value named. */
+    CHECK(rfFeederSetBeginStepDt(set, 0.0, -0.01) == rfErrorInvalidArgument);
+    CHECK_MENTIONS(rfFeederSetGetLastError(set), "step = -0.01");
+    CHECK(rfFeederSetBeginStepDt(set, 0.0, INFINITY) == rfErrorInvalidArgument);
+    CHECK_MENTIONS(rfFeederSetGetLastError(set), "step = inf");
+    CHECK(rfFeederSetBeginStepDt(set, 0.0, NAN) == rfErrorInvalidArgument);
+    CHECK_MENTIONS(rfFeederSetGetLastError(set), "step = nan");
+    CHECK(rfFeederSetBeginStepDt(0, 0.0, h) == rfErrorInvalidArgument);
+    CHECK(rfFeederSetRemove(set, table_geom) == rfOK);
+  }
+
   /* Errors: a NaN speed, named in the message. */
   CHECK(rfFeederSetAddBelt(set, other, x_axis, NAN, rfFrameWorld) == rfErrorInvalidArgument);
   CHECK_MENTIONS(rfFeederSetGetLastError(set), "belt.speed");
@@ -262,6 +304,7 @@ int main(void) {
   rfFeederSetDestroy(0);
 
   rfFeederSetDestroy(set);
+  dGeomDestroy(table_geom);
   dGeomDestroy(field_geom);
   dGeomDestroy(other);
   dGeomDestroy(part_geom);

@@ -131,6 +131,48 @@ TEST_F(HandMadeContacts, FDir1IsUnitTangentAndMotion1MovesThePartWithTheSurface)
   }
 }
 
+TEST_F(HandMadeContacts, WithTheStepARotatingFeederCarriesThePartsCentreOfMassOnItsChord) {
+  // Turntable w = 2 rad/s about +z through O, step h = 0.05 s (a turn of 0.1 rad). The part's
+  // body is at x_c: a sticking part must move rigidly, its centre of mass along the chord to
+  // x_c turned by w h about O, spinning at w. So the contact at p asks for
+  // (Rot(w h)(x_c - O) + O - x_c) / h + w x (p - x_c) (tangential part), written out here with
+  // cos and sin, for either geom order and a static or body feeder.
+  const double w = 2.0, h = 0.05;
+  const Vec3 o{0.1, -0.2, 0.0}, xc{0.4, 0.3, 0.02}, n{0, 0, 1};
+  FeederSet set;
+  set.add(static_feeder_, MotionLaw::rotation({0, 0, w}, o));
+  set.add(body_feeder_, MotionLaw::rotation({0, 0, w}, o));
+  dBodySetPosition(dGeomGetBody(part_), xc.x, xc.y, xc.z);
+  const double c = std::cos(w * h), s = std::sin(w * h);
+  const Vec3 r = xc - o;
+  const Vec3 chord{(c * r.x - s * r.y - r.x) / h, (s * r.x + c * r.y - r.y) / h, 0.0};
+  for (const Vec3& p : {Vec3{0.38, 0.28, 0}, Vec3{0.42, 0.32, 0}, Vec3{0.1, -0.2, 0}}) {
+    const Vec3 expected = chord + Vec3{-w * (p.y - xc.y), w * (p.x - xc.x), 0.0};
+    for (dGeomID feeder : {static_feeder_, body_feeder_}) {
+      for (bool feeder_g1 : {true, false}) {
+        dContact contact_ = feeder_g1 ? contact(feeder, part_, p, n) : contact(part_, feeder, p, n);
+        set.beginStep(0.0, h);
+        ASSERT_EQ(set.driveContacts(&contact_, 1), 1);
+        const Vec3 imposed = imposedPartVelocity(contact_, part_, false);
+        EXPECT_NEAR(imposed.x, expected.x, kRoundOff);
+        EXPECT_NEAR(imposed.y, expected.y, kRoundOff);
+        EXPECT_NEAR(imposed.z, expected.z, kRoundOff);
+      }
+    }
+  }
+  // Against the static environment (no body to carry) the contact point's own chord is used.
+  const Vec3 p{0.4, 0.3, 0};
+  dContact alone = contact(body_feeder_, nullptr, p, n);
+  set.beginStep(0.0, h);
+  ASSERT_EQ(set.driveContacts(&alone, 1), 1);
+  const Vec3 rp = p - o;
+  const Vec3 own{(c * rp.x - s * rp.y - rp.x) / h, (s * rp.x + c * rp.y - rp.y) / h, 0.0};
+  // The feeder's body is node0: motion1 fdir1 = c_rel = 0 - c_feeder.
+  const Vec3 imposed = alone.surface.motion1 * fdir1(alone);
+  EXPECT_NEAR(imposed.x, -own.x, kRoundOff);
+  EXPECT_NEAR(imposed.y, -own.y, kRoundOff);
+}
+
 TEST_F(HandMadeContacts, Approx1IsForcedOnFeederContactsOnly) {
   FeederSet set;
   set.add(static_feeder_, MotionLaw::belt({1, 0, 0}, 0.3));

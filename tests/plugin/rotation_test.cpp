@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Rotation laws (MotionLaw::rotation) on whole scenes: a turntable carries parts along w x r,
+// a part sticking to it stays on its circle over a long run when the step is given (the secant),
 // a rotating helical ramp lifts a part when w agrees with the helix's handedness.
 #include <gtest/gtest.h>
 
@@ -127,6 +128,114 @@ TEST(Turntable, NegativeOmegaTurnsPartsClockwise) {
   EXPECT_LT(tangential, 0.0);
   EXPECT_NEAR(tangential, -kTableW * std::hypot(position(part).x, position(part).y), 1e-5);
   EXPECT_NEAR(angularVelocity(part).z, -kTableW, kLcpTolerance);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Turntable over a long run at a large step: the secant surface velocity
+
+namespace {
+
+// A box sticking to a turntable (w about +z, static feeder geom) keeps its distance r to the
+// axis, its polar angle advances by w t and it spins at w: rigid co-rotation. Stepping with
+// h = 0.01 s for 60 s, the secant surface velocity (the step given to collide) carries its
+// centre of mass along the chord to the point turned by w h each step; the instantaneous w x r
+// carries it along the tangent, to a radius sqrt(1 + (w h)^2) times larger each step.
+constexpr double kLongStep = 0.01;    // s
+constexpr double kLongDuration = 60;  // s
+constexpr double kLongRadius = 0.1;   // m, initial distance of the box's centre to the axis
+// Sticking needs m w^2 r <= mu m g: w^2 r = 2.5 m/s^2 at w = 5 rad/s, r = 0.1 m.
+constexpr double kLongMu = 1.0;
+// The requirement for a sticking part: radius constant to 1e-6 relative over 60 s.
+// What remains is CFM's creep: the four contacts share the centripetal force m w^2 r and each
+// slips outwards at cfm m w^2 r / 4, r0 cfm m w^2 t / 4 = 3.75e-8 r0 at w = 5 rad/s (measured).
+constexpr double kRadiusTolerance = 1e-6;  // relative
+// dWorldStep solves each LCP exactly up to CFM 1e-9 (tests/support/ode_world.hpp): the same
+// budget as the radius for the arc, 1e-6 r.
+constexpr double kAngleTolerance = 1e-6;  // rad
+constexpr double kSpinTolerance = 1e-6;   // rad/s
+
+struct LongRun {
+  double worst_radius_error = 0;  // max |r - r0| / r0 over the run
+  double final_radius_ratio = 1;  // r / r0 at the end
+  double angle_error = 0;         // unwrapped polar angle - w t at the end (rad)
+  double spin = 0;                // angular velocity z at the end (rad/s)
+  int steps = 0;
+  bool finite = true;
+};
+
+// `step_given` is what the application passes to ContactCollider::collide: h, or 0 for the
+// instantaneous field.
+LongRun runLongTurntable(double w, double step_given) {
+  OdeWorld world;
+  world.setSurface(dContactApprox1, kLongMu);
+  dWorldSetContactSurfaceLayer(world.world, kLayer);
+  const dGeomID table = world.staticBox(1.2, 1.2, 0.1, 0, 0, -0.05);
+  world.feeders->add(table, MotionLaw::rotation({0, 0, w}, {0, 0, 0}));
+  // Starts co-rotating and kLayer deep (in contact), so it sticks from the first step on.
+  dBodyID box =
+      world.box(kPartSize, kPartSize, kPartSize, kPartMass, kLongRadius, 0, kPartSize / 2 - kLayer);
+  dBodySetLinearVel(box, 0, w * kLongRadius, 0);
+  dBodySetAngularVel(box, 0, 0, w);
+
+  LongRun run;
+  run.steps = static_cast<int>(kLongDuration / kLongStep + 0.5);
+  double angle = 0, previous = 0;
+  for (int i = 0; i < run.steps; ++i) {
+    world.collider->collide(world.space, world.time, step_given);
+    dWorldStep(world.world, kLongStep);
+    world.time += kLongStep;
+    const Vec3 p = position(box);
+    if (!isFinite(p)) {
+      run.finite = false;
+      return run;
+    }
+    const double a = std::atan2(p.y, p.x);
+    angle += std::remainder(a - previous, 2 * kPi);  // turns of w h << pi per step
+    previous = a;
+    run.final_radius_ratio = std::hypot(p.x, p.y) / kLongRadius;
+    run.worst_radius_error =
+        std::fmax(run.worst_radius_error, std::fabs(run.final_radius_ratio - 1));
+  }
+  run.angle_error = angle - w * world.time;
+  run.spin = angularVelocity(box).z;
+  std::printf(
+      "[ measured ] ODE turntable w = %g rad/s, h = %g s, step given %g s, %g s: max "
+      "|r - r0|/r0 = %.3g, r/r0 = %.9f, angle - w t = %.3g rad, spin - w = %.3g rad/s\n",
+      w, kLongStep, step_given, world.time, run.worst_radius_error, run.final_radius_ratio,
+      run.angle_error, run.spin - w);
+  return run;
+}
+
+}  // namespace
+
+TEST(TurntableSecant, StickingBoxStaysOnItsCircleAtOneRadPerSecond) {
+  const LongRun run = runLongTurntable(1.0, kLongStep);
+  ASSERT_TRUE(run.finite);
+  EXPECT_LT(run.worst_radius_error, kRadiusTolerance);
+  EXPECT_NEAR(run.angle_error, 0.0, kAngleTolerance);
+  EXPECT_NEAR(run.spin, 1.0, kSpinTolerance);
+}
+
+TEST(TurntableSecant, StickingBoxStaysOnItsCircleAtFiveRadPerSecond) {
+  const LongRun run = runLongTurntable(5.0, kLongStep);
+  ASSERT_TRUE(run.finite);
+  EXPECT_LT(run.worst_radius_error, kRadiusTolerance);
+  EXPECT_NEAR(run.angle_error, 0.0, kAngleTolerance);
+  EXPECT_NEAR(run.spin, 5.0, kSpinTolerance);
+}
+
+// Documented behaviour without the step (step = 0): each step moves the sticking box along the
+// tangent by w r h, to radius r sqrt(1 + (w h)^2) and polar angle + atan(w h). After n steps
+// r / r0 = (1 + (w h)^2)^(n/2) (1.3498 here) and the angle lags w t by n (w h - atan(w h)).
+TEST(TurntableSecant, WithoutTheStepTheBoxSpiralsOutwardsAlongTheTangent) {
+  constexpr double kW = 1.0;
+  const LongRun run = runLongTurntable(kW, 0.0);
+  ASSERT_TRUE(run.finite);
+  const double turn = kW * kLongStep;
+  const double expected_ratio = std::pow(1.0 + turn * turn, 0.5 * run.steps);
+  EXPECT_NEAR(run.final_radius_ratio, expected_ratio, kRadiusTolerance * expected_ratio);
+  EXPECT_NEAR(run.angle_error, -run.steps * (turn - std::atan(turn)), kAngleTolerance);
+  EXPECT_GT(run.worst_radius_error, 0.3);  // far outside the secant's tolerance
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -11,12 +11,12 @@
 ///       for (int i = 0; i < n; ++i) { c[i].surface.mode = 0; c[i].surface.mu = 0.5; }
 ///       return true;                                  // false: no joints for this pair
 ///     });
-///     // each step:
-///     collider.collide(space, time);                  // beginStep + dSpaceCollide + joints
+///     // each step of h seconds:
+///     collider.collide(space, time, h);               // beginStep + dSpaceCollide + joints
 ///     dWorldQuickStep(world, h);
 ///
 /// Applications that call dSpaceCollide themselves pass `&collider` and
-/// `ContactCollider::nearCallback` to it (after `beginStep(time)` and `clearJoints()`).
+/// `ContactCollider::nearCallback` to it (after `beginStep(time, h)` and `clearJoints()`).
 #pragma once
 
 #include <ode/ode.h>
@@ -62,8 +62,11 @@ class ContactCollider {
   /// The application's surface callback (optional).
   void setSurfaceCallback(SurfaceCallback callback);
 
-  /// One step's collision at simulation time `time` (s): empties the joint group, calls
-  /// feeders.beginStep(time), collides `space` (recursing into sub-spaces) and creates joints.
+  /// One step's collision at simulation time `time` (s) for a step of `step` (s; the h the
+  /// world is then stepped with, see FeederSet::beginStep; 0 gives rotating laws'
+  /// instantaneous field): empties the joint group, calls feeders.beginStep(time, step),
+  /// collides `space` (recursing into sub-spaces) and creates joints. Throws
+  /// std::invalid_argument (from beginStep) for a non-finite time or a bad step.
   void collide(dSpaceID space, double time, double step = 0.0);
   /// Empties the contact joint group (collide does it).
   void clearJoints();

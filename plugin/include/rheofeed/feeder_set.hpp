@@ -7,16 +7,24 @@
 ///
 ///     rheofeed::FeederSet feeders;
 ///     feeders.add(belt_geom, rheofeed::MotionLaw::belt({1, 0, 0}, 0.3));
-///     // each step:
-///     feeders.beginStep(time);                       // once, before dSpaceCollide
+///     // each step of h seconds:
+///     feeders.beginStep(time, h);                    // once, before dSpaceCollide
 ///     // in the near callback, after dCollide filled `contact[0..n)` and the surface params:
 ///     n = feeders.driveContacts(contact, n);         // feeder contacts get fdir1/motion1
 ///     for (int i = 0; i < n; ++i) dJointAttach(dJointCreateContact(w, g, &contact[i]),
 ///                                              dGeomGetBody(o1), dGeomGetBody(o2));
+///     dWorldQuickStep(world, h);                     // the same h as given to beginStep
+///
+/// Pass the step h that the world is stepped with: rotating laws then give the secant of the
+/// surface motion over the step (motion_law.hpp), and a part sticking to a turntable stays on
+/// its circle. Without it (step = 0) they give the instantaneous w x r, and such a part spirals
+/// outwards by sqrt(1 + (w h)^2) per step.
 ///
 /// ## What a driven contact gets
-/// With c_F the tangential surface velocity (motion_law.hpp) of a feeder geom F at the contact,
-/// and c = 0 for a geom that is no feeder, the contact between geoms g1 and g2 asks that the
+/// With c_F the tangential surface velocity (motion_law.hpp) of a feeder geom F at the contact
+/// (for a rotating law given the step: the secant that carries the other geom's body, whose
+/// position is its centre of mass, rigidly with the surface), and c = 0 for a geom that is no
+/// feeder, the contact between geoms g1 and g2 asks that the
 /// material points in contact move together: (v_g1 + c_g1) - (v_g2 + c_g2) has no tangential
 /// part, where v is the velocity of the geom's body at the contact point (0 for a static geom).
 /// ODE's friction row 1 enforces (v_node0 - v_node1) . fdir1 = motion1, where node0 is the
@@ -148,11 +156,14 @@ class FeederSet {
   /// Number of registered feeders.
   int size() const;
 
-  /// Start a step at simulation time `time` (s) of length `step` (s): call once per step before
-  /// collision. Laws are frozen lazily at this time on their first contact. With `step` > 0 a
-  /// rotating law gives the secant surface velocity over the step, so a part sticking to a
-  /// turntable stays on its circle; `step` = 0 gives the instantaneous w x r. Throws if time is
-  /// not finite or step is negative or not finite.
+  /// Start a step at simulation time `time` (s) of length `step` (s, the h the world is then
+  /// stepped with): call once per step before collision. Every law is frozen anew each step,
+  /// lazily at this time on its first contact. With `step` > 0 a rotating law gives the secant
+  /// surface velocity over the step, so a part sticking to a turntable stays on its circle;
+  /// `step` = 0 gives the instantaneous w x r (and its outward drift). A change of step counts
+  /// as a change of motion (parts asleep on a rotating feeder are woken). Throws
+  /// std::invalid_argument naming the value if time is not finite or step is negative or not
+  /// finite (nothing is changed then).
   void beginStep(double time, double step = 0.0);
   /// The time given to the latest beginStep (s).
   double time() const;

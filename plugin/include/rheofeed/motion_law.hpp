@@ -18,6 +18,29 @@
 /// unit contact normal. Penetration recovery, restitution and any normal motion stay as the
 /// application set them.
 ///
+/// ## Pass the step length: the secant of a rotation
+/// A time stepper moves a sticking part by `h c` per step. With the instantaneous field
+/// `c = w x (p - O)` that is a move along the tangent, off the circle: a part resting on a
+/// turntable spirals outwards by a factor sqrt(1 + (w h)^2) per step (x1.35 in 60 s at
+/// w = 1 rad/s, h = 0.01 s). Given the step h (s) (MotionLaw::evaluate, FeederSet::beginStep,
+/// ContactCollider::collide, rfFeederSetBeginStepDt), a law with w != 0 instead gives the secant
+/// of the motion over the step. The twist, frozen at the start of the step (world frame), is the
+/// screw field `v_par + w x (p - O')`, with v_par = (v . w) w / |w|^2 the part of v along w and
+/// O' = O + (w x v) / |w|^2 a point on the screw axis; its flow over h maps p to
+/// `O' + R(w h) (p - O') + v_par h` (R(w h): rotation by |w| h about w), so the secant is
+///
+///     c = v_par + (R(w h) - I) (p - O') / h                  (-> v + w x (p - O) as h -> 0)
+///
+/// and a point carried at `c` lands exactly on the rotated (for a screw: helical) point. The
+/// tangential part is taken as above. These point secants are not a rigid field (they contract
+/// towards the axis at (1 - cos(|w| h)) / h times the distance to it), so the contacts of one part
+/// would ask for incompatible motions; FeederSet and the reference world therefore give every
+/// contact of a part with centre of mass x_c the rigid motion `c(x_c) + w x (p - x_c)`, which lands
+/// x_c on its rotated point and turns the part at w (StepLaw::tangentialVelocity with `carried`).
+/// Always pass the step your integrator takes; step = 0 keeps the instantaneous field (bitwise as
+/// before issue 7), and its outward drift. Translations, belts and fields do not depend on the
+/// step.
+///
 /// All vectors are in metres, m/s and rad/s; "world" means the ODE world frame, "body" means the
 /// frame of the body that carries the feeder geom (the law then follows the body).
 #pragma once
@@ -137,10 +160,13 @@ class MotionLaw {
   /// e.g. "feeder 0x55d0: law twist.linear.x = nan is not finite".
   void validate(const std::string& where) const;
 
-  /// Freeze the law at time `t` (s) for a step of `step` seconds. `body_pose` is the pose of the
-  /// body carrying the feeder (needed for Frame::Body, ignored otherwise; nullptr means the world
-  /// frame). With `step` > 0 a rotating twist gives the secant surface velocity over the step
-  /// (see StepLaw::tangentialVelocity); `step` = 0 gives the instantaneous field v + w x (p - O).
+  /// Freeze the law at time `t` (s) for a step of `step` seconds (finite, >= 0; any other value
+  /// gives a law that is not finite(), whose problem() names it). `body_pose` is the pose of the
+  /// body carrying the feeder at time t (needed for Frame::Body, ignored otherwise; nullptr means
+  /// the world frame). The twist (profile applied; Frame::Body and twist functions first turned
+  /// into a world twist at t) is then held constant over the step. With `step` > 0 a law with w !=
+  /// 0 gives the secant surface velocity over the step (file comment); `step` = 0 gives the
+  /// instantaneous field v + w x (p - O).
   StepLaw evaluate(double t, const Pose* body_pose, double step = 0.0) const;
 
  private:
@@ -158,9 +184,23 @@ class MotionLaw {
 class StepLaw {
  public:
   /// Tangential surface velocity c_t (m/s, world) at contact point `p` (m, world) with unit
-  /// normal `n`. Non-finite only if a user function returned a non-finite value (then
-  /// `isFinite` of the result is false and the caller leaves the contact undriven).
+  /// normal `n`: the instantaneous field, or for a rotating law frozen with a step h > 0 the
+  /// secant over the step (file comment). Non-finite only if a user function returned a
+  /// non-finite value (then `isFinite` of the result is false and the caller leaves the contact
+  /// undriven).
   Vec3 tangentialVelocity(const Vec3& p, const Vec3& n) const;
+  /// The same for a contact of a rigid part whose centre of mass is at `carried` (m, world, at
+  /// the start of the step): for a secant law, the velocity at `p` of the rigid motion that
+  /// carries the centre of mass along its secant and turns the part at w,
+  /// c = secant(carried) + w x (p - carried). A part sticking to a turntable then has its
+  /// centre of mass land exactly on the rotated point, and every one of its contacts asks for
+  /// the same rigid motion (the secants of the contact points themselves differ from a rigid
+  /// field by -(1 - cos(w h)) / h times their in-plane spread, which no rigid part can follow).
+  /// Equal to the two-argument form for every other law, and for carried = p.
+  Vec3 tangentialVelocity(const Vec3& p, const Vec3& n, const Vec3& carried) const;
+  /// True if `carried` changes tangentialVelocity (a secant law): callers may skip looking up
+  /// the carried body otherwise.
+  bool usesCarriedPoint() const { return eval_ == Eval::Secant; }
 
   /// Whether the frozen values are all finite (a profile or twist function can fail).
   bool finite() const { return finite_; }
@@ -173,9 +213,17 @@ class StepLaw {
 
  private:
   friend class MotionLaw;
-  enum class Eval { Zero, Translation, Twist, Belt, Field };
+  enum class Eval { Zero, Translation, Twist, Secant, Belt, Field };
+  // Turns a Twist (w != 0) into its secant over a step of h > 0 seconds: c = M (p - O) + d.
+  void freezeSecant(double h);
+  // The (untruncated) secant velocity at p: M (p - O) + d.
+  Vec3 secant(const Vec3& p) const;
+
   Eval eval_ = Eval::Zero;
-  Vec3 v_, w_, o_;  // world frame; Belt: v_ = unit direction, w_.x = speed
+  Vec3 v_, w_, o_;     // world frame; Belt: v_ = unit direction, w_.x = speed
+  double m_[9] = {};   // Secant: (R(w h) - I) / h (1/s, row-major, world)
+  Vec3 d_;             // Secant: c at p = O (m/s, world)
+  double step_ = 0.0;  // h (s) of a Secant, else 0
   const SurfaceField* field_ = nullptr;
   double scale_ = 1.0;
   double time_ = 0.0;

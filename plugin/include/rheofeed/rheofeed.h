@@ -10,8 +10,10 @@
  *     rfFeederSetID feeders = rfFeederSetCreate();
  *     double dir[3] = {1, 0, 0};
  *     rfFeederSetAddBelt(feeders, belt_geom, dir, 0.3, rfFrameWorld);
- *     // each step: rfFeederSetBeginStep(feeders, t); then in the near callback:
+ *     // each step of h seconds: rfFeederSetBeginStepDt(feeders, t, h); then in the near
+ *     // callback:
  *     n = rfFeederSetDriveContacts(feeders, contact, n);
+ *     // and step the world with the same h: dWorldQuickStep(world, h);
  *
  * Units: metres, seconds, m/s, rad/s. Vectors are double[3] in the world frame unless the law's
  * frame is rfFrameBody (then in the frame of the feeder geom's body).
@@ -93,7 +95,15 @@ int rfFeederSetRemove(rfFeederSetID set, dGeomID geom);
 /** 1 if `geom` is a registered feeder, else 0. */
 int rfFeederSetContains(rfFeederSetID set, dGeomID geom);
 
-/** Start a step at simulation time `time` (s), before collision. */
+/** Start a step at simulation time `time` (s) of length `step` (s, finite and >= 0: the h the
+ *  world is then stepped with), once per step before collision. Rotating laws then give the
+ *  secant of the surface motion over the step, so a part sticking to a turntable stays on its
+ *  circle (motion_law.hpp). rfErrorInvalidArgument for a non-finite time or a negative or
+ *  non-finite step (the message names the value; nothing is changed). */
+int rfFeederSetBeginStepDt(rfFeederSetID set, double time, double step);
+/** rfFeederSetBeginStepDt with step = 0: rotating laws give the instantaneous w x r, and a part
+ *  sticking to a turntable spirals outwards by sqrt(1 + (w h)^2) per step of h seconds. Kept for
+ *  existing callers; prefer rfFeederSetBeginStepDt. */
 int rfFeederSetBeginStep(rfFeederSetID set, double time);
 /** Drive the feeder contacts of `contacts[0..count)`; returns how many contacts to create
  *  joints for (invalid feeder contacts are removed, the rest kept in order), or a negative

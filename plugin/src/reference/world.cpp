@@ -177,14 +177,17 @@ struct World::Impl {
     }
   }
 
-  // Tangential surface velocity of geom g at p with normal n (0 if g is no feeder).
-  Vector3d surfaceVelocity(dGeomID g, const Vector3d& p, const Vector3d& n) const {
+  // Tangential surface velocity of geom g at p with normal n (0 if g is no feeder), carrying
+  // the body `carried` on the other side of the contact (StepLaw::tangentialVelocity).
+  Vector3d surfaceVelocity(dGeomID g, const Vector3d& p, const Vector3d& n, BodyId carried) const {
     auto it = feeders.find(g);
     if (it == feeders.end()) return Vector3d::Zero();
-    return toEigen(it->second.frozen.tangentialVelocity(toVec3(p), toVec3(n)));
+    const StepLaw& law = it->second.frozen;
+    if (carried == kStatic) return toEigen(law.tangentialVelocity(toVec3(p), toVec3(n)));
+    return toEigen(law.tangentialVelocity(toVec3(p), toVec3(n), bodies[carried].state.position));
   }
 
-  void freezeLaws() {
+  void freezeLaws(double h) {
     for (auto& [geom, f] : feeders) {
       Pose pose;
       const Pose* body_pose = nullptr;
@@ -193,7 +196,7 @@ struct World::Impl {
         pose = poseOf(toEigen(bodies[b].state.position), rotation(b));
         body_pose = &pose;
       }
-      f.frozen = f.law.evaluate(time, body_pose);
+      f.frozen = f.law.evaluate(time, body_pose, h);
       if (!f.frozen.finite()) refuse("feeder law is not finite: " + f.frozen.problem());
     }
   }
@@ -374,7 +377,7 @@ StepReport World::step(double h) {
   }
 
   s.placeGeoms();
-  s.freezeLaws();
+  s.freezeLaws(h);
   s.raw.clear();
   dSpaceCollide(s.space, &s, &Impl::nearCallback);
 
@@ -412,7 +415,8 @@ StepReport World::step(double h) {
     std::vector<Matrix3d> frames(static_cast<std::size_t>(nc));  // columns n, t1, t2
     for (int i = 0; i < nc; ++i) {
       const Impl::RawContact& c = s.raw[static_cast<std::size_t>(i)];
-      const Vector3d c_rel = s.surfaceVelocity(c.g2, c.p, c.n) - s.surfaceVelocity(c.g1, c.p, c.n);
+      const Vector3d c_rel =
+          s.surfaceVelocity(c.g2, c.p, c.n, c.a) - s.surfaceVelocity(c.g1, c.p, c.n, c.b);
       const Vector3d c_t = c_rel - c_rel.dot(c.n) * c.n;
       Vector3d t1, t2;
       const double speed = c_t.norm();
