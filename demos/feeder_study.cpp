@@ -119,10 +119,10 @@ int main(int argc, char** argv) {
     const Scene calibrated = withCalibration(scene, cal);
     std::string classical_line;
     try {
-      const Calibration quick = calibrateClassical(scene, fixture);
+      const Calibration estimate = calibrateClassical(scene, fixture);
       std::ostringstream q;
-      q << "Classical single-part estimate: " << quick.value << " m/s ("
-        << 100 * std::abs(quick.value - ref) / std::abs(ref) << " % from the reference).\n";
+      q << "Classical single-part estimate: " << estimate.value << " m/s ("
+        << 100 * std::abs(estimate.value - ref) / std::abs(ref) << " % from the reference).\n";
       classical_line = q.str();
     } catch (const std::exception& e) {
       classical_line =

@@ -26,22 +26,6 @@ constexpr double kGap = 1e-3;
 /// Vibration angle beta of the vibrating tracks (rad): 30 degrees, a usual linear feeder.
 constexpr double kBeta = kPi / 6;
 
-/// Bounding radius (m) of a part family's mean part, as drawParts computes it.
-double boundOf(const PartSpec& p) {
-  switch (p.shape) {
-    case Shape::Kind::Box:
-      return 0.5 * norm({p.size[0].mean, p.size[1].mean, p.size[2].mean});
-    case Shape::Kind::Sphere:
-      return p.size[0].mean;
-    case Shape::Kind::Cylinder:
-      return std::hypot(p.size[0].mean, 0.5 * p.size[1].mean);
-    case Shape::Kind::Capsule:
-      return p.size[0].mean + 0.5 * p.size[1].mean;
-    default:
-      return p.size[0].mean;
-  }
-}
-
 /// Builds one case step by step.
 class Builder {
  public:

@@ -123,7 +123,9 @@ void expectSameScene(const Scene& a, const Scene& b) {
                   : pa.shape == Shape::Kind::Cylinder || pa.shape == Shape::Kind::Capsule ? 2
                                                                                           : 1;
     for (int d = 0; d < n; ++d) expectSame(pa.size[d], pb.size[d], w + ".size");
-    if (pa.shape == Shape::Kind::Mesh) EXPECT_EQ(pa.mesh, pb.mesh) << w;
+    if (pa.shape == Shape::Kind::Mesh) {
+      EXPECT_EQ(pa.mesh, pb.mesh) << w;
+    }
     EXPECT_EQ(pa.density, pb.density) << w;
     expectSame(pa.spawn_min, pb.spawn_min, w + ".spawn_min");
     expectSame(pa.spawn_max, pb.spawn_max, w + ".spawn_max");

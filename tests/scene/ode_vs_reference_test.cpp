@@ -63,12 +63,15 @@ TEST(OdeVsReference, TurntablePartsMoveAtOmegaTimesRadiusAlongOmegaCrossR) {
   for (const RunSummary* r : {&c.a, &c.b}) {
     SCOPED_TRACE(toString(r->method));
     for (const PartState& p : r->states) {
-      // The end-of-step velocity is w x r at the start of the step (semi-implicit Euler:
-      // x+ = x + h v+), so the reported position is one step (w h rad) further round.
+      // A sticking part follows the chord of its circle (secant surface velocity): over a step
+      // of h it turns by w h rad, so its end-of-step velocity is (R(w h) - I) r_start / h, and
+      // the reported position (semi-implicit Euler: x+ = x + h v+) is r_end = R(w h) r_start.
       const double h = 0.01;
-      const double c = std::cos(-omega * h), s = std::sin(-omega * h);
-      const Vec3 start{c * p.position.x - s * p.position.y, s * p.position.x + c * p.position.y, 0};
-      const Vec3 expected = cross(Vec3{0, 0, omega}, start);  // w x r
+      const double cs = std::cos(-omega * h), sn = std::sin(-omega * h);
+      const Vec3 start{cs * p.position.x - sn * p.position.y, sn * p.position.x + cs * p.position.y,
+                       0};
+      const Vec3 end{p.position.x, p.position.y, 0};
+      const Vec3 expected = (1.0 / h) * (end - start);  // the chord over one step
       EXPECT_NEAR(p.velocity.x, expected.x, kStickSpeedTolerance);
       EXPECT_NEAR(p.velocity.y, expected.y, kStickSpeedTolerance);
       EXPECT_NEAR(p.angular_velocity.z, omega, kStickSpeedTolerance);

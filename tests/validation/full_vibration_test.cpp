@@ -230,7 +230,9 @@ TEST_P(SlidingSpeed, MatchesClassicalModel) {
   const Measured m = run(trackScene(c.track), method);
   report(c.track.name, method, d, m);
   EXPECT_NEAR(m.speed, d.mean_speed, speedTolerance(d.mean_speed));
-  if (d.mean_speed != 0) EXPECT_GT(m.speed * d.mean_speed, 0.0) << "conveys the wrong way";
+  if (d.mean_speed != 0) {
+    EXPECT_GT(m.speed * d.mean_speed, 0.0) << "conveys the wrong way";
+  }
   expectFlatAndStraight(m);
   EXPECT_EQ(m.no_contact_fraction, 0.0);
 }

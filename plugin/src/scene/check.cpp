@@ -110,10 +110,6 @@ struct Box3 {
   }
 };
 
-double component(const Vec3& v, int i) {
-  return i == 0 ? v.x : (i == 1 ? v.y : v.z);
-}
-
 Box3 geomBounds(const Fixture::Geom& g) {
   Box3 b;
   const Shape& s = g.shape;

@@ -140,8 +140,8 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
         continue;
       }
       if (sample) {
-        const double progress = angular ? tr.turned - tr.previous_turned : dot(x - tr.previous, d);
-        v.push_back(progress / (every * h));
+        const double advance = angular ? tr.turned - tr.previous_turned : dot(x - tr.previous, d);
+        v.push_back(advance / (every * h));
         tr.previous = x;
         tr.previous_turned = tr.turned;
         z += x.z;
@@ -191,8 +191,8 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
     }
     dz += tr.end.z - tr.spawn.z;
     if (tr.start_time >= 0 && tr.end_time > tr.start_time) {
-      const double progress = angular ? tr.end_turned - tr.start_turned : dot(tr.end - tr.start, d);
-      drift.push_back(progress / (tr.end_time - tr.start_time));
+      const double advance = angular ? tr.end_turned - tr.start_turned : dot(tr.end - tr.start, d);
+      drift.push_back(advance / (tr.end_time - tr.start_time));
     }
   }
   m.mean_drift = mean(drift);

@@ -667,9 +667,9 @@ void checkFixtureMesh(const TriangleMesh& mesh, const Vec3& position, const std:
   }
   const double diagonal = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
   const std::string name = "mesh '" + mesh.source + "'";
-  auto range = [](double lo, double hi) {  // as Scene::validate writes its ranges
+  auto range = [](double low, double high) {  // as Scene::validate writes its ranges
     std::ostringstream out;
-    out << "[" << lo << ", " << hi << "] m";
+    out << "[" << low << ", " << high << "] m";
     return out.str();
   };
   if (!(diagonal >= limits::kMinSize && diagonal <= limits::kMaxSize)) {
