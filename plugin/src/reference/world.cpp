@@ -89,10 +89,12 @@ struct World::Impl {
     Vector3d force = Vector3d::Zero(), torque = Vector3d::Zero();
   };
   struct Attached {
+    dGeomID geom;
     BodyId body;
     Pose offset;
   };
   struct Feeder {
+    dGeomID geom;
     MotionLaw law;
     StepLaw frozen;
   };
@@ -108,8 +110,14 @@ struct World::Impl {
   dSpaceID space = nullptr;
   double time = 0;
   std::vector<Body> bodies;
-  std::unordered_map<dGeomID, Attached> attached;
-  std::unordered_map<dGeomID, Feeder> feeders;
+  // Attached geoms and feeders in insertion order, with an index by geom for lookups. Loops run
+  // over the vectors, never over the maps: placeGeoms calls dGeomSetPosition, which moves the
+  // geom to the front of its space's list, so that order is the collision (and contact) order,
+  // and an order by pointer hash would make runs depend on heap addresses.
+  std::vector<Attached> attached;
+  std::unordered_map<dGeomID, std::size_t> attached_index;
+  std::vector<Feeder> feeders;
+  std::unordered_map<dGeomID, std::size_t> feeder_index;
   FrictionCallback friction;
   ccp::Solver solver;
   std::vector<RawContact> raw;
@@ -119,8 +127,8 @@ struct World::Impl {
   ccp::Problem problem;  // the last step's contact problem
 
   BodyId bodyOf(dGeomID g) const {
-    auto it = attached.find(g);
-    return it == attached.end() ? kStatic : it->second.body;
+    auto it = attached_index.find(g);
+    return it == attached_index.end() ? kStatic : attached[it->second].body;
   }
   bool isDynamic(BodyId b) const { return b != kStatic && !bodies[b].kinematic; }
 
@@ -141,7 +149,8 @@ struct World::Impl {
   }
 
   void placeGeoms() {
-    for (auto& [geom, a] : attached) {
+    for (const Attached& a : attached) {
+      const dGeomID geom = a.geom;
       const Body& body = bodies[a.body];
       const Matrix3d rb = rotation(a.body);
       const Matrix3d r = rb * rotationOf(a.offset);
@@ -179,21 +188,21 @@ struct World::Impl {
 
   // Tangential surface velocity of geom g at p with normal n (0 if g is no feeder).
   Vector3d surfaceVelocity(dGeomID g, const Vector3d& p, const Vector3d& n) const {
-    auto it = feeders.find(g);
-    if (it == feeders.end()) return Vector3d::Zero();
-    return toEigen(it->second.frozen.tangentialVelocity(toVec3(p), toVec3(n)));
+    auto it = feeder_index.find(g);
+    if (it == feeder_index.end()) return Vector3d::Zero();
+    return toEigen(feeders[it->second].frozen.tangentialVelocity(toVec3(p), toVec3(n)));
   }
 
-  void freezeLaws() {
-    for (auto& [geom, f] : feeders) {
+  void freezeLaws(double h) {
+    for (Feeder& f : feeders) {
       Pose pose;
       const Pose* body_pose = nullptr;
-      const BodyId b = bodyOf(geom);
+      const BodyId b = bodyOf(f.geom);
       if (b != kStatic) {
         pose = poseOf(toEigen(bodies[b].state.position), rotation(b));
         body_pose = &pose;
       }
-      f.frozen = f.law.evaluate(time, body_pose);
+      f.frozen = f.law.evaluate(time, body_pose, h);
       if (!f.frozen.finite()) refuse("feeder law is not finite: " + f.frozen.problem());
     }
   }
@@ -304,9 +313,10 @@ void World::attachGeom(dGeomID geom, BodyId body, const Pose& offset) {
   if (dGeomGetBody(geom))
     refuse("attachGeom: geom has an ODE body; reference geoms must have none");
   if (dGeomGetSpace(geom) != impl_->space) refuse("attachGeom: geom is not in World::space()");
-  if (impl_->attached.count(geom)) refuse("attachGeom: geom is already attached");
+  if (impl_->attached_index.count(geom)) refuse("attachGeom: geom is already attached");
   if (!isFinite(offset.position)) refuse("attachGeom: offset position is not finite");
-  impl_->attached.emplace(geom, Impl::Attached{body, offset});
+  impl_->attached_index.emplace(geom, impl_->attached.size());
+  impl_->attached.push_back(Impl::Attached{geom, body, offset});
 }
 
 void World::setFeeder(dGeomID geom, MotionLaw law) {
@@ -314,7 +324,13 @@ void World::setFeeder(dGeomID geom, MotionLaw law) {
   std::ostringstream where;
   where << "rheofeed::reference::World::setFeeder: geom " << static_cast<const void*>(geom);
   law.validate(where.str());
-  impl_->feeders[geom] = Impl::Feeder{std::move(law), StepLaw{}};
+  auto it = impl_->feeder_index.find(geom);
+  if (it != impl_->feeder_index.end()) {
+    impl_->feeders[it->second].law = std::move(law);
+    return;
+  }
+  impl_->feeder_index.emplace(geom, impl_->feeders.size());
+  impl_->feeders.push_back(Impl::Feeder{geom, std::move(law), StepLaw{}});
 }
 
 void World::setFrictionCallback(FrictionCallback callback) {
@@ -374,7 +390,7 @@ StepReport World::step(double h) {
   }
 
   s.placeGeoms();
-  s.freezeLaws();
+  s.freezeLaws(h);
   s.raw.clear();
   dSpaceCollide(s.space, &s, &Impl::nearCallback);
 
@@ -574,8 +590,8 @@ void World::disableBody(BodyId body) {
   b.disabled = true;
   b.state.linear_velocity = {};
   b.state.angular_velocity = {};
-  for (auto& [geom, a] : impl_->attached) {
-    if (a.body == body) dGeomDisable(geom);
+  for (const Impl::Attached& a : impl_->attached) {
+    if (a.body == body) dGeomDisable(a.geom);
   }
 }
 
