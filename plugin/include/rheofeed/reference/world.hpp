@@ -7,9 +7,17 @@
 /// are not used. This file is the one adapter between ODE's collision data and the Eigen solver.
 ///
 /// ## Time step (semi-implicit Euler, velocity level, as ODE's)
-///   v_free = v + h M^-1 (f_ext + m g) - h I^-1 (w x I w)       (gyroscopic term explicit)
+///   v_free = v + h (f_ext / m + g)                               (linear, m/s)
+///   w_free = R G_h(R^T w) + h I_world^-1 tau_ext                 (angular, rad/s)
 ///   u = D^T v+ + b,  v+ = v_free + M^-1 D gamma,  gamma from the CCP (problem.hpp)
 ///   x+ = x + h v+,   q+ = normalise(q + h/2 (0, w+) q)
+/// G_h is the torque-free rotation (Euler's equation I dw/dt = -w x I w) over h in the body
+/// frame by the implicit midpoint rule, solved by Newton: it keeps the kinetic energy and |L|
+/// of a free body to round-off at any step, where an explicit `w x I w` term pumps energy
+/// (x650 in 1.2 s at h = 0.05 s for a tumbling box). The rotation about w+ leaves w+ fixed in
+/// the body, so a free body's energy cannot grow. (ODE 0.16 takes one implicit-Euler Newton
+/// step, which dissipates instead.) Accuracy still needs h |w| << 1: the precession of a
+/// tumbling body is first-order accurate in h |w|.
 ///
 /// ## Contacts
 /// For a contact from dCollide(g1, g2): body A carries g1, body B carries g2 (either may be
@@ -110,6 +118,9 @@ struct StepReport {
   /// True when the true-Coulomb fixed point (Settings::solver.coulomb_outer_iterations > 0)
   /// did not settle and the step used the relaxed CCP instead.
   bool coulomb_fallback = false;
+  /// Dynamic bodies whose implicit-midpoint gyroscopic solve did not converge this step (only
+  /// for h |w| far beyond 1); they got one dissipative implicit-Euler Newton step instead.
+  int gyroscopic_fallbacks = 0;
 };
 
 /// The reference world. Geoms are created by the caller in space() without ODE bodies and then
