@@ -183,6 +183,20 @@ struct World::Impl {
   }
   bool isDynamic(BodyId b) const { return b != kStatic && !bodies[b].kinematic; }
 
+  // Takes a dynamic body out of the simulation: it stops where it is, its geoms no longer
+  // collide.
+  void disable(BodyId body) {
+    Body& b = bodies[static_cast<std::size_t>(body)];
+    b.disabled = true;
+    b.state.linear_velocity = {};
+    b.state.angular_velocity = {};
+    b.force.setZero();
+    b.torque.setZero();
+    for (const Attached& a : attached) {
+      if (a.body == body) dGeomDisable(a.geom);
+    }
+  }
+
   Matrix3d rotation(BodyId b) const {
     return toEigen(bodies[b].state.orientation).normalized().toRotationMatrix();
   }
@@ -440,11 +454,6 @@ StepReport World::step(double h) {
     next_pose[k] = p1;
   }
 
-  s.placeGeoms();
-  s.freezeLaws(h);
-  s.raw.clear();
-  dSpaceCollide(s.space, &s, &Impl::nearCallback);
-
   // Free velocities of the dynamic bodies.
   StepReport report;
   int ndof = 0;
@@ -473,7 +482,20 @@ StepReport World::step(double h) {
     v_free.segment<3>(b.dof) =
         toEigen(b.state.linear_velocity) + h * (toEigen(cfg.gravity) + b.force / b.mass);
     v_free.segment<3>(b.dof + 3) = w + h * inv_inertia_world[k] * b.torque;
+    if (!v_free.segment<6>(b.dof).allFinite()) {
+      // E.g. forces or torques whose sum or effect overflows: the body stops where it is.
+      v_free.segment<6>(b.dof).setZero();
+      s.disable(static_cast<BodyId>(k));
+      report.nonfinite_bodies.push_back(static_cast<BodyId>(k));
+    }
   }
+
+  // Collision after the free velocities, so that bodies found non-finite there no longer
+  // collide.
+  s.placeGeoms();
+  s.freezeLaws(h);
+  s.raw.clear();
+  dSpaceCollide(s.space, &s, &Impl::nearCallback);
 
   const int nc = static_cast<int>(s.raw.size());
   report.contacts = nc;
@@ -584,6 +606,15 @@ StepReport World::step(double h) {
     if (report.solve.status == ccp::Status::InvalidInput) {
       refuse("step: the contact problem was refused: " + report.solve.message);
     }
+    if (!gamma.allFinite()) {
+      // Not expected (the solver returns its last finite iterate), but never integrated: the
+      // non-finite contact blocks apply no impulse and the step's status says so.
+      for (int i = 0; i < 3 * nc; ++i) {
+        if (!std::isfinite(gamma(i))) gamma.segment<3>(3 * (i / 3)).setZero();
+      }
+      report.solve.status = ccp::Status::NumericalIssue;
+      report.solve.message += " (non-finite impulses were dropped)";
+    }
     v_next = v_free + minv * (d * gamma);
     const Eigen::VectorXd u = d.transpose() * v_next + (r - d.transpose() * v_free);
 
@@ -619,6 +650,7 @@ StepReport World::step(double h) {
       continue;
     }
     if (b.disabled) continue;
+    const BodyState before = b.state;
     const Vector3d v = v_next.segment<3>(b.dof), w = v_next.segment<3>(b.dof + 3);
     b.state.linear_velocity = toVec3(v);
     b.state.angular_velocity = toVec3(w);
@@ -630,9 +662,14 @@ StepReport World::step(double h) {
     b.state.orientation = toQuat(q.normalized());
     b.force.setZero();
     b.torque.setZero();
-    if (!isFinite(b.state.position) || !isFinite(b.state.linear_velocity)) {
-      refuse("step: body " + std::to_string(k) + " state became non-finite (solver status " +
-             ccp::toString(report.solve.status) + ")");
+    const Quat& q_new = b.state.orientation;
+    if (!isFinite(b.state.position) || !isFinite(b.state.linear_velocity) ||
+        !isFinite(b.state.angular_velocity) ||
+        !(std::isfinite(q_new.w) && std::isfinite(q_new.x) && std::isfinite(q_new.y) &&
+          std::isfinite(q_new.z))) {
+      b.state = before;  // the last finite state; disable() zeroes the velocities
+      s.disable(static_cast<BodyId>(k));
+      report.nonfinite_bodies.push_back(static_cast<BodyId>(k));
     }
   }
   s.time += h;
@@ -643,13 +680,7 @@ void World::disableBody(BodyId body) {
   if (body < 0 || body >= numBodies() || impl_->bodies[body].kinematic) {
     refuse("disableBody: " + std::to_string(body) + " is not a dynamic body");
   }
-  Impl::Body& b = impl_->bodies[body];
-  b.disabled = true;
-  b.state.linear_velocity = {};
-  b.state.angular_velocity = {};
-  for (const Impl::Attached& a : impl_->attached) {
-    if (a.body == body) dGeomDisable(a.geom);
-  }
+  impl_->disable(body);
 }
 
 double World::time() const {

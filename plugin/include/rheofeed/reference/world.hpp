@@ -131,6 +131,10 @@ struct StepReport {
   /// Dynamic bodies whose implicit-midpoint gyroscopic solve did not converge this step (only
   /// for h |w| far beyond 1); they got one dissipative implicit-Euler Newton step instead.
   int gyroscopic_fallbacks = 0;
+  /// Dynamic bodies whose state (position, orientation, linear or angular velocity) or free
+  /// velocity became non-finite this step (e.g. forces that overflow). Each is disabled as by
+  /// World::disableBody at its last finite pose, with zero velocity; the others step on.
+  std::vector<BodyId> nonfinite_bodies;
 };
 
 /// The reference world. Geoms are created by the caller in space() without ODE bodies and then
@@ -165,8 +169,9 @@ class World {
   /// External force (N) and torque (N m) on a body for the next step only (world frame).
   void addForce(BodyId body, const Vec3& force, const Vec3& torque = {});
 
-  /// Advance by h (s). Throws std::invalid_argument if h is not finite and > 0. A solver that
-  /// does not converge is reported in the StepReport (status), not thrown.
+  /// Advance by h (s). Throws std::invalid_argument if h is not finite and > 0, or on bad
+  /// settings, laws or friction coefficients (named). A solver that does not converge and a
+  /// body whose state becomes non-finite are reported in the StepReport, not thrown.
   StepReport step(double h);
 
   /// Take a dynamic body out of the simulation for good: it stops where it is and its geoms
