@@ -293,6 +293,11 @@ std::string settingsProblem(const Settings& settings) {
         << " must be >= 1";
   else if (!(settings.default_mu >= 0) || !std::isfinite(settings.default_mu))
     bad << "Settings::default_mu = " << settings.default_mu << " must be finite and >= 0";
+  else if (!(settings.restitution >= 0 && settings.restitution <= 1))
+    bad << "Settings::restitution = " << settings.restitution << " must be in [0, 1]";
+  else if (!(settings.bounce_velocity >= 0) || !std::isfinite(settings.bounce_velocity))
+    bad << "Settings::bounce_velocity = " << settings.bounce_velocity
+        << " must be finite and >= 0 (m/s)";
   else if (!isFinite(settings.gravity))
     bad << "Settings::gravity is not finite";
   else if (std::string m = settings.solver.validate(); !m.empty())
@@ -459,6 +464,7 @@ StepReport World::step(double h) {
   int ndof = 0;
   for (const auto& b : s.bodies) ndof += b.kinematic ? 0 : 6;
   Eigen::VectorXd v_free(ndof);
+  Eigen::VectorXd v_pre = Eigen::VectorXd::Zero(ndof);  // pre-step velocities, for restitution
   std::vector<Matrix3d> inv_inertia_world(s.bodies.size(), Matrix3d::Zero());
   for (std::size_t k = 0; k < s.bodies.size(); ++k) {
     Impl::Body& b = s.bodies[k];
@@ -470,6 +476,8 @@ StepReport World::step(double h) {
       v_free.segment<6>(b.dof).setZero();
       continue;
     }
+    v_pre.segment<3>(b.dof) = toEigen(b.state.linear_velocity);
+    v_pre.segment<3>(b.dof + 3) = toEigen(b.state.angular_velocity);
     // Solved in the world frame with I_world = R I R^T (Euler's equation reads the same there,
     // I_world dw/dt = -w x I_world w, with I_world frozen over the step). Mapping w to the body
     // and back instead would scale it by the rotation's round-off, twice per step, and that
@@ -526,7 +534,16 @@ StepReport World::step(double h) {
           s.pointVelocity(c.a, c.p, v_free) - s.pointVelocity(c.b, c.p, v_free);
       const double push = std::min(cfg.erp * std::max(c.depth - cfg.surface_layer, 0.0) / h,
                                    cfg.max_correcting_velocity);
-      r(3 * i) = c.n.dot(rel_free) - push;
+      // Restitution as ODE's dContactBounce: when the pre-step approach speed exceeds
+      // bounce_velocity, the normal row targets u_n+ >= e * approach, or the ERP push if that is
+      // larger (the push alone is capped by max_correcting_velocity, the bounce is not).
+      double target = push;
+      if (cfg.restitution > 0) {
+        const double approach =
+            -c.n.dot(s.pointVelocity(c.a, c.p, v_pre) - s.pointVelocity(c.b, c.p, v_pre));
+        if (approach > cfg.bounce_velocity) target = std::max(target, cfg.restitution * approach);
+      }
+      r(3 * i) = c.n.dot(rel_free) - target;
       r(3 * i + 1) = t1.dot(rel_free) - t1.dot(c_t);
       r(3 * i + 2) = t2.dot(rel_free) - t2.dot(c_t);
       mu(i) = c.mu;

@@ -102,8 +102,15 @@ struct Settings {
   double surface_layer = 0.0;     ///< as dWorldSetContactSurfaceLayer (m)
   int max_contacts_per_pair = 8;  ///< contacts asked of dCollide per pair
   double default_mu = 0.5;        ///< friction coefficient when no callback is set
-  bool warm_start = true;         ///< reuse last step's impulses per (pair, index)
-  ccp::Settings solver;           ///< the CCP solver's settings
+  /// Coefficient of restitution e (dimensionless, 0..1), as ODE's dContactBounce with
+  /// surface.bounce = e: when the pre-step approach speed -u_n (m/s) of a contact exceeds
+  /// bounce_velocity, its normal row asks u_n+ >= e (-u_n) (Newton's impact law), or the ERP
+  /// push if that is larger. 0: no bounce.
+  double restitution = 0.0;
+  /// Minimum approach speed for a bounce (m/s, >= 0), as ODE's surface.bounce_vel.
+  double bounce_velocity = 0.0;
+  bool warm_start = true;  ///< reuse last step's impulses per (pair, index)
+  ccp::Settings solver;    ///< the CCP solver's settings
   /// Use the dense Delassus matrix up to this many contacts, matrix-free above.
   int dense_contact_limit = 100;
 };
