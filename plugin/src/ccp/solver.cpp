@@ -269,7 +269,11 @@ Result Solver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
       physicalVelocity();
       const double coulomb =
           coulombResidual(gamma, ws.u, problem.mu, settings_.residual_rho) / scale;
-      if (coulomb < best_coulomb) {
+      // The relaxed iterate is returned only as a Coulomb solution (below): as a best-effort
+      // answer it would separate every sliding contact at mu ||u_t||, which is what Coulomb
+      // mode exists to avoid. (With coulomb_outer_iterations == 1 it is the only iterate.)
+      const bool candidate = outer > 0 || settings_.coulomb_outer_iterations == 1;
+      if (candidate && coulomb < best_coulomb) {
         best_coulomb = coulomb;
         best_inner_residual = outcome.residual;
         ws.coulomb_best = gamma;

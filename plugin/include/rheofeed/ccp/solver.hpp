@@ -56,7 +56,7 @@ enum class Status {
   /// solve).
   Converged,
   /// The iteration or time budget ran out first; gamma is the best iterate found (in Coulomb
-  /// mode: the outer iterate with the lowest Coulomb residual).
+  /// mode: the shifted outer iterate with the lowest Coulomb residual).
   MaxIterations,
   /// A non-finite value appeared during the iterations; gamma is the last finite best iterate.
   NumericalIssue,
@@ -99,7 +99,8 @@ struct Settings {
   /// previous solution, warm-started. It stops when the Coulomb residual (see
   /// Result::coulomb_distance) is at or below tolerance, or when the added term changes by less
   /// than coulomb_tolerance with a converged inner solve; otherwise (Status::MaxIterations) the
-  /// iterate with the lowest Coulomb residual is returned.
+  /// shifted iterate with the lowest Coulomb residual is returned (never the relaxed one, whose
+  /// sliding contacts separate at mu ||u_t||, unless k == 1).
   int coulomb_outer_iterations = 0;
   /// Coulomb mode stops when `||s_new - s_old|| / (1 + ||r||) <= coulomb_tolerance`, where
   /// `s_i = mu_i ||u_t,i||` (m/s) is the normal shift (>= 0, dimensionless like tolerance).

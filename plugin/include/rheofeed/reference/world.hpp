@@ -19,6 +19,14 @@
 /// step, which dissipates instead.) Accuracy still needs h |w| << 1: the precession of a
 /// tumbling body is first-order accurate in h |w|.
 ///
+/// ## Determinism
+/// Geoms are placed (dGeomSetPosition, which reorders ODE's space) and feeders evaluated in the
+/// order they were attached/set, never in an order of pointer values: the same scene built the
+/// same way gives bit-identical states in any process.
+///
+/// ## Restitution
+/// Settings::restitution and bounce_velocity follow ODE's dContactBounce: see Settings.
+///
 /// ## Contacts
 /// For a contact from dCollide(g1, g2): body A carries g1, body B carries g2 (either may be
 /// static or kinematic), n is ODE's normal (from g2 into g1), p the contact point. The contact
@@ -82,13 +90,13 @@ struct BodyState {
 
 /// Contact impulse of the last step, in the world frame.
 struct ContactImpulse {
-  dGeomID g1 = nullptr, g2 = nullptr;
-  BodyId body1 = kStatic, body2 = kStatic;
-  Vec3 position;               ///< (m)
-  Vec3 normal;                 ///< unit, from g2 into g1
-  double depth = 0;            ///< (m)
-  double normal_impulse = 0;   ///< gamma_n (N s), on body1 along +normal
-  Vec3 tangential_impulse;     ///< friction impulse on body1 (N s)
+  dGeomID g1 = nullptr, g2 = nullptr;       ///< the geoms, in dCollide's order
+  BodyId body1 = kStatic, body2 = kStatic;  ///< bodies carrying g1 and g2 (kStatic: none)
+  Vec3 position;                            ///< (m)
+  Vec3 normal;                              ///< unit, from g2 into g1
+  double depth = 0;                         ///< (m)
+  double normal_impulse = 0;                ///< gamma_n (N s), on body1 along +normal
+  Vec3 tangential_impulse;                  ///< friction impulse on body1 (N s)
   Vec3 slip;                   ///< u_t after the step (m/s): v_1 - v_2 - (c_2 - c_1), tangential
   double normal_velocity = 0;  ///< u_n after the step (m/s), > 0 separating
 };
@@ -123,7 +131,8 @@ struct StepReport {
   /// Contacts found by collision detection (dynamic bodies against anything).
   int contacts = 0;
   /// The solver's result for the step's contact problem (status, iterations, residuals, time);
-  /// status NotRun when there was no contact.
+  /// status NotRun when there was no contact. NumericalIssue also when non-finite impulses
+  /// had to be dropped (they are never integrated).
   ccp::Result solve;
   /// True when the true-Coulomb fixed point (Settings::solver.coulomb_outer_iterations > 0) did
   /// not settle (solve.status MaxIterations) and the step used the solver's best Coulomb
