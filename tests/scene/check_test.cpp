@@ -270,14 +270,6 @@ TEST(SceneCheck, SpawnInsideAFixtureAndBelowTheRemovalHeightFire) {
   EXPECT_EQ(r[0].value, 0.006);
 }
 
-TEST(SceneCheck, RestitutionIsReportedAsIgnoredByTheReference) {
-  Scene s = beltScene();
-  s.material.restitution = 0.5;
-  EXPECT_EQ(ofKind(checkScene(s, Method::ReferenceRheonomic), Hazard::Kind::IgnoredSetting).size(),
-            1u);
-  EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::IgnoredSetting).empty());
-}
-
 TEST(SceneCheck, FormatNamesKindPathAndSafeSetting) {
   Hazard h;
   h.kind = Hazard::Kind::Tunnelling;

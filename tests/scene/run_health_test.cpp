@@ -333,16 +333,6 @@ TEST(RunHealth, ReferenceListsTheOdeStepperChoice) {
   EXPECT_TRUE(mentions(ignored, "solver.ode_quickstep = false"));
 }
 
-// Delete with the restitution block of reference_simulation.cpp once the reference world
-// implements restitution.
-TEST(RunHealth, ReferenceListsRestitutionUntilItImplementsIt) {
-  Scene s = beltScene();
-  s.material.restitution = 0.5;
-  EXPECT_TRUE(mentions(makeSimulation(s, Method::ReferenceRheonomic)->health().ignored_settings,
-                       "material.restitution = 0.5"));
-  EXPECT_TRUE(makeSimulation(s, Method::OdeRheonomic)->health().ignored_settings.empty());
-}
-
 // ---- Outputs --------------------------------------------------------------------------------
 
 TEST(RunHealth, JsonAndCsvCarryTheCounts) {

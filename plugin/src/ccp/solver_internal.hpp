@@ -16,15 +16,17 @@ namespace rheofeed::ccp::detail {
 /// Preallocated vectors. resize() only allocates when a size changes.
 struct Workspace {
   // Contact space (3 nc).
-  Eigen::VectorXd u;          // contact velocity N gamma + r of the current iterate
-  Eigen::VectorXd r_shifted;  // Coulomb mode: r with mu ||u_t|| added to the normal rows
-  Eigen::VectorXd iterate;    // APGD gamma_k, PGS current gamma
-  Eigen::VectorXd n_iterate;  // APGD N gamma_k
-  Eigen::VectorXd next;       // APGD gamma_{k+1}
-  Eigen::VectorXd n_next;     // APGD N gamma_{k+1}
-  Eigen::VectorXd y;          // APGD extrapolated point
-  Eigen::VectorXd n_y;        // APGD N y
-  Eigen::VectorXd best;       // best iterate by residual
+  Eigen::VectorXd u;             // contact velocity N gamma + r of the current iterate
+  Eigen::VectorXd r_shifted;     // Coulomb mode: r with mu ||u_t|| added to the normal rows
+  Eigen::VectorXd iterate;       // APGD gamma_k, PGS current gamma
+  Eigen::VectorXd n_iterate;     // APGD N gamma_k
+  Eigen::VectorXd next;          // APGD gamma_{k+1}
+  Eigen::VectorXd n_next;        // APGD N gamma_{k+1}
+  Eigen::VectorXd y;             // APGD extrapolated point
+  Eigen::VectorXd n_y;           // APGD N y
+  Eigen::VectorXd best;          // best iterate by residual
+  Eigen::VectorXd coulomb_best;  // Coulomb mode: the outer iterate with the lowest Coulomb residual
+  Eigen::VectorXd coulomb_start;  // Coulomb mode: the incoming gamma (start of the shift iteration)
   // Contacts (nc).
   Eigen::VectorXd eta;        // PGS block step 3 / trace(N_ii)
   Eigen::VectorXd shift;      // Coulomb mode: current s_i = mu_i ||u_t,i||

@@ -74,6 +74,57 @@ void planeSpace(const Vector3d& n, Vector3d& t1, Vector3d& t2) {
 // Below this surface speed (m/s) the friction frame is ODE's plane space, not aligned with c.
 constexpr double kMinSurfaceSpeed = 1e-12;
 
+Matrix3d skew(const Vector3d& a) {
+  Matrix3d m;
+  m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  return m;
+}
+
+// Newton iterations of the implicit midpoint gyroscopic solve; quadratic convergence needs a
+// handful where h |w| < 1, the cap only stops a solve that does not converge.
+constexpr int kGyroNewtonIterations = 30;
+
+// Torque-free rotation over one step (inertia and w in one frame, here the world frame with the
+// inertia frozen at the step's start; principal axes or not): Euler's equation
+// I dw/dt + w x I w = 0 by the implicit midpoint rule,
+//   I (w2 - w1) = -h wm x I wm,   wm = (w1 + w2) / 2,
+// solved for wm by Newton on G(wm) = 2 I (wm - w1) + h wm x I wm with Jacobian
+// 2 I + h (skew(wm) I - skew(I wm)), starting at wm = w1. Both first integrals are kept in exact
+// arithmetic: dotting with wm gives w2.I w2 = w1.I w1 (energy), and with L = I w,
+// L2 - L1 = -h wm x (L1 + L2) / 2 is orthogonal to L1 + L2, so |L2| = |L1| (a Cayley rotation).
+// (ODE 0.16 takes one Newton step of implicit Euler instead, which dissipates both.) The world
+// rotates the body about w2 afterwards, which leaves w2 . I w2 unchanged, so a free body's
+// energy is carried from step to step. Should Newton not converge (h |w| far beyond 1), one Newton
+// step of implicit Euler from w1 is used (`converged` false). Either way the energy may not grow: a
+// result with w2.I w2 > w1.I w1 (round-off, or the fallback) is scaled back to w1's energy.
+Vector3d gyroscopicStep(const Matrix3d& inertia, const Vector3d& w1, double h, bool& converged) {
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  Vector3d wm = w1;
+  converged = false;
+  for (int k = 0; k < kGyroNewtonIterations; ++k) {
+    const Vector3d iwm = inertia * wm;
+    const Vector3d g = 2 * inertia * (wm - w1) + h * wm.cross(iwm);
+    const Matrix3d jac = 2 * inertia + h * (skew(wm) * inertia - skew(iwm));
+    const Vector3d dw = jac.fullPivLu().solve(g);
+    if (!dw.allFinite()) break;
+    wm -= dw;
+    if (dw.norm() <= 8 * kEps * wm.norm()) {
+      converged = true;
+      break;
+    }
+  }
+  Vector3d w2 = 2 * wm - w1;
+  if (!converged || !w2.allFinite()) {
+    const Vector3d iw = inertia * w1;
+    const Matrix3d jac = inertia + h * (skew(w1) * inertia - skew(iw));
+    w2 = w1 - jac.fullPivLu().solve(h * w1.cross(iw));
+    converged = false;
+  }
+  const double e1 = w1.dot(inertia * w1), e2 = w2.dot(inertia * w2);
+  if (e2 > e1) w2 *= std::sqrt(e1 / e2);
+  return w2;
+}
+
 }  // namespace
 
 struct World::Impl {
@@ -89,10 +140,12 @@ struct World::Impl {
     Vector3d force = Vector3d::Zero(), torque = Vector3d::Zero();
   };
   struct Attached {
+    dGeomID geom;
     BodyId body;
     Pose offset;
   };
   struct Feeder {
+    dGeomID geom;
     MotionLaw law;
     StepLaw frozen;
   };
@@ -108,8 +161,14 @@ struct World::Impl {
   dSpaceID space = nullptr;
   double time = 0;
   std::vector<Body> bodies;
-  std::unordered_map<dGeomID, Attached> attached;
-  std::unordered_map<dGeomID, Feeder> feeders;
+  // Attached geoms and feeders in insertion order, with an index by geom for lookups. Loops run
+  // over the vectors, never over the maps: placeGeoms calls dGeomSetPosition, which moves the
+  // geom to the front of its space's list, so that order is the collision (and contact) order,
+  // and an order by pointer hash would make runs depend on heap addresses.
+  std::vector<Attached> attached;
+  std::unordered_map<dGeomID, std::size_t> attached_index;
+  std::vector<Feeder> feeders;
+  std::unordered_map<dGeomID, std::size_t> feeder_index;
   FrictionCallback friction;
   ccp::Solver solver;
   std::vector<RawContact> raw;
@@ -119,10 +178,24 @@ struct World::Impl {
   ccp::Problem problem;  // the last step's contact problem
 
   BodyId bodyOf(dGeomID g) const {
-    auto it = attached.find(g);
-    return it == attached.end() ? kStatic : it->second.body;
+    auto it = attached_index.find(g);
+    return it == attached_index.end() ? kStatic : attached[it->second].body;
   }
   bool isDynamic(BodyId b) const { return b != kStatic && !bodies[b].kinematic; }
+
+  // Takes a dynamic body out of the simulation: it stops where it is, its geoms no longer
+  // collide.
+  void disable(BodyId body) {
+    Body& b = bodies[static_cast<std::size_t>(body)];
+    b.disabled = true;
+    b.state.linear_velocity = {};
+    b.state.angular_velocity = {};
+    b.force.setZero();
+    b.torque.setZero();
+    for (const Attached& a : attached) {
+      if (a.body == body) dGeomDisable(a.geom);
+    }
+  }
 
   Matrix3d rotation(BodyId b) const {
     return toEigen(bodies[b].state.orientation).normalized().toRotationMatrix();
@@ -141,7 +214,8 @@ struct World::Impl {
   }
 
   void placeGeoms() {
-    for (auto& [geom, a] : attached) {
+    for (const Attached& a : attached) {
+      const dGeomID geom = a.geom;
       const Body& body = bodies[a.body];
       const Matrix3d rb = rotation(a.body);
       const Matrix3d r = rb * rotationOf(a.offset);
@@ -180,18 +254,18 @@ struct World::Impl {
   // Tangential surface velocity of geom g at p with normal n (0 if g is no feeder), carrying
   // the body `carried` on the other side of the contact (StepLaw::tangentialVelocity).
   Vector3d surfaceVelocity(dGeomID g, const Vector3d& p, const Vector3d& n, BodyId carried) const {
-    auto it = feeders.find(g);
-    if (it == feeders.end()) return Vector3d::Zero();
-    const StepLaw& law = it->second.frozen;
+    auto it = feeder_index.find(g);
+    if (it == feeder_index.end()) return Vector3d::Zero();
+    const StepLaw& law = feeders[it->second].frozen;
     if (carried == kStatic) return toEigen(law.tangentialVelocity(toVec3(p), toVec3(n)));
     return toEigen(law.tangentialVelocity(toVec3(p), toVec3(n), bodies[carried].state.position));
   }
 
   void freezeLaws(double h) {
-    for (auto& [geom, f] : feeders) {
+    for (Feeder& f : feeders) {
       Pose pose;
       const Pose* body_pose = nullptr;
-      const BodyId b = bodyOf(geom);
+      const BodyId b = bodyOf(f.geom);
       if (b != kStatic) {
         pose = poseOf(toEigen(bodies[b].state.position), rotation(b));
         body_pose = &pose;
@@ -222,6 +296,11 @@ std::string settingsProblem(const Settings& settings) {
         << " must be >= 1";
   else if (!(settings.default_mu >= 0) || !std::isfinite(settings.default_mu))
     bad << "Settings::default_mu = " << settings.default_mu << " must be finite and >= 0";
+  else if (!(settings.restitution >= 0 && settings.restitution <= 1))
+    bad << "Settings::restitution = " << settings.restitution << " must be in [0, 1]";
+  else if (!(settings.bounce_velocity >= 0) || !std::isfinite(settings.bounce_velocity))
+    bad << "Settings::bounce_velocity = " << settings.bounce_velocity
+        << " must be finite and >= 0 (m/s)";
   else if (!isFinite(settings.gravity))
     bad << "Settings::gravity is not finite";
   else if (std::string m = settings.solver.validate(); !m.empty())
@@ -307,9 +386,10 @@ void World::attachGeom(dGeomID geom, BodyId body, const Pose& offset) {
   if (dGeomGetBody(geom))
     refuse("attachGeom: geom has an ODE body; reference geoms must have none");
   if (dGeomGetSpace(geom) != impl_->space) refuse("attachGeom: geom is not in World::space()");
-  if (impl_->attached.count(geom)) refuse("attachGeom: geom is already attached");
+  if (impl_->attached_index.count(geom)) refuse("attachGeom: geom is already attached");
   if (!isFinite(offset.position)) refuse("attachGeom: offset position is not finite");
-  impl_->attached.emplace(geom, Impl::Attached{body, offset});
+  impl_->attached_index.emplace(geom, impl_->attached.size());
+  impl_->attached.push_back(Impl::Attached{geom, body, offset});
 }
 
 void World::setFeeder(dGeomID geom, MotionLaw law) {
@@ -317,7 +397,13 @@ void World::setFeeder(dGeomID geom, MotionLaw law) {
   std::ostringstream where;
   where << "rheofeed::reference::World::setFeeder: geom " << static_cast<const void*>(geom);
   law.validate(where.str());
-  impl_->feeders[geom] = Impl::Feeder{std::move(law), StepLaw{}};
+  auto it = impl_->feeder_index.find(geom);
+  if (it != impl_->feeder_index.end()) {
+    impl_->feeders[it->second].law = std::move(law);
+    return;
+  }
+  impl_->feeder_index.emplace(geom, impl_->feeders.size());
+  impl_->feeders.push_back(Impl::Feeder{geom, std::move(law), StepLaw{}});
 }
 
 void World::setFrictionCallback(FrictionCallback callback) {
@@ -376,35 +462,53 @@ StepReport World::step(double h) {
     next_pose[k] = p1;
   }
 
-  s.placeGeoms();
-  s.freezeLaws(h);
-  s.raw.clear();
-  dSpaceCollide(s.space, &s, &Impl::nearCallback);
-
   // Free velocities of the dynamic bodies.
+  StepReport report;
   int ndof = 0;
   for (const auto& b : s.bodies) ndof += b.kinematic ? 0 : 6;
   Eigen::VectorXd v_free(ndof);
+  Eigen::VectorXd v_pre = Eigen::VectorXd::Zero(ndof);  // pre-step velocities, for restitution
   std::vector<Matrix3d> inv_inertia_world(s.bodies.size(), Matrix3d::Zero());
   for (std::size_t k = 0; k < s.bodies.size(); ++k) {
     Impl::Body& b = s.bodies[k];
     if (b.kinematic) continue;
     const Matrix3d r = s.rotation(static_cast<BodyId>(k));
-    const Matrix3d i_world = r * b.inertia_body * r.transpose();
     // A disabled body keeps its mass in M^-1 (it has no contacts) but does not move.
     inv_inertia_world[k] = r * b.inv_inertia_body * r.transpose();
     if (b.disabled) {
       v_free.segment<6>(b.dof).setZero();
       continue;
     }
-    const Vector3d w = toEigen(b.state.angular_velocity);
+    v_pre.segment<3>(b.dof) = toEigen(b.state.linear_velocity);
+    v_pre.segment<3>(b.dof + 3) = toEigen(b.state.angular_velocity);
+    // Solved in the world frame with I_world = R I R^T (Euler's equation reads the same there,
+    // I_world dw/dt = -w x I_world w, with I_world frozen over the step). Mapping w to the body
+    // and back instead would scale it by the rotation's round-off, twice per step, and that
+    // bias accumulates (~3e-16 of the energy per step, measured).
+    Matrix3d i_world = r * b.inertia_body * r.transpose();
+    i_world = 0.5 * (i_world + i_world.transpose()).eval();
+    bool converged = true;
+    const Vector3d w = gyroscopicStep(i_world, toEigen(b.state.angular_velocity), h, converged);
+    if (!converged) report.gyroscopic_fallbacks++;
     v_free.segment<3>(b.dof) =
         toEigen(b.state.linear_velocity) + h * (toEigen(cfg.gravity) + b.force / b.mass);
-    v_free.segment<3>(b.dof + 3) = w + h * inv_inertia_world[k] * (b.torque - w.cross(i_world * w));
+    v_free.segment<3>(b.dof + 3) = w + h * inv_inertia_world[k] * b.torque;
+    if (!v_free.segment<6>(b.dof).allFinite()) {
+      // E.g. forces or torques whose sum or effect overflows: the body stops where it is.
+      v_free.segment<6>(b.dof).setZero();
+      s.disable(static_cast<BodyId>(k));
+      report.nonfinite_bodies.push_back(static_cast<BodyId>(k));
+    }
   }
 
+  // Collision after the free velocities, so that bodies found non-finite there no longer
+  // collide.
+  s.placeGeoms();
+  s.freezeLaws(h);
+  s.raw.clear();
+  dSpaceCollide(s.space, &s, &Impl::nearCallback);
+
   const int nc = static_cast<int>(s.raw.size());
-  StepReport report;
   report.contacts = nc;
   Eigen::VectorXd v_next = v_free;
   std::vector<ContactImpulse> out(static_cast<std::size_t>(nc));
@@ -434,7 +538,16 @@ StepReport World::step(double h) {
           s.pointVelocity(c.a, c.p, v_free) - s.pointVelocity(c.b, c.p, v_free);
       const double push = std::min(cfg.erp * std::max(c.depth - cfg.surface_layer, 0.0) / h,
                                    cfg.max_correcting_velocity);
-      r(3 * i) = c.n.dot(rel_free) - push;
+      // Restitution as ODE's dContactBounce: when the pre-step approach speed exceeds
+      // bounce_velocity, the normal row targets u_n+ >= e * approach, or the ERP push if that is
+      // larger (the push alone is capped by max_correcting_velocity, the bounce is not).
+      double target = push;
+      if (cfg.restitution > 0) {
+        const double approach =
+            -c.n.dot(s.pointVelocity(c.a, c.p, v_pre) - s.pointVelocity(c.b, c.p, v_pre));
+        if (approach > cfg.bounce_velocity) target = std::max(target, cfg.restitution * approach);
+      }
+      r(3 * i) = c.n.dot(rel_free) - target;
       r(3 * i + 1) = t1.dot(rel_free) - t1.dot(c_t);
       r(3 * i + 2) = t2.dot(rel_free) - t2.dot(c_t);
       mu(i) = c.mu;
@@ -501,19 +614,27 @@ StepReport World::step(double h) {
     }
     s.solver.settings() = cfg.solver;
     report.solve = s.solver.solve(problem, gamma);
-    if (cfg.solver.coulomb_outer_iterations > 0 &&
-        report.solve.status == ccp::Status::MaxIterations) {
-      // The true-Coulomb fixed point is not a convex problem and may fail to settle (impacts
-      // in a falling pile); its last iterate can then be far from any physical answer. Fall
-      // back to the relaxed CCP for this step, which always has a unique u.
-      ccp::Settings relaxed = cfg.solver;
-      relaxed.coulomb_outer_iterations = 0;
-      s.solver.settings() = relaxed;
-      report.solve = s.solver.solve(problem, gamma);
-      report.coulomb_fallback = true;
-    }
+    // When the true-Coulomb fixed point does not settle, the solver returns its outer iterate
+    // with the lowest Coulomb residual, and the step uses it. The relaxed CCP is no fallback:
+    // it separates every sliding contact at u_n = mu |u_t| (a box on a 10 m/s belt with
+    // mu = 0.5 leaves at 5 m/s). A shifted iterate k + 1 separates a sliding contact only by
+    // mu (|u_t^(k+1)| - |u_t^(k)|), the change of slip between iterates, and the Coulomb
+    // residual (reported) bounds that: with rho = 1 a pressed contact's normal velocity error is
+    // at most coulomb_residual (1 + |r|) (m/s).
+    report.coulomb_fallback = cfg.solver.coulomb_outer_iterations > 0 &&
+                              report.solve.status == ccp::Status::MaxIterations;
+    report.coulomb_residual = report.solve.coulomb_distance;
     if (report.solve.status == ccp::Status::InvalidInput) {
       refuse("step: the contact problem was refused: " + report.solve.message);
+    }
+    if (!gamma.allFinite()) {
+      // Not expected (the solver returns its last finite iterate), but never integrated: the
+      // non-finite contact blocks apply no impulse and the step's status says so.
+      for (int i = 0; i < 3 * nc; ++i) {
+        if (!std::isfinite(gamma(i))) gamma.segment<3>(3 * (i / 3)).setZero();
+      }
+      report.solve.status = ccp::Status::NumericalIssue;
+      report.solve.message += " (non-finite impulses were dropped)";
     }
     v_next = v_free + minv * (d * gamma);
     const Eigen::VectorXd u = d.transpose() * v_next + (r - d.transpose() * v_free);
@@ -550,6 +671,7 @@ StepReport World::step(double h) {
       continue;
     }
     if (b.disabled) continue;
+    const BodyState before = b.state;
     const Vector3d v = v_next.segment<3>(b.dof), w = v_next.segment<3>(b.dof + 3);
     b.state.linear_velocity = toVec3(v);
     b.state.angular_velocity = toVec3(w);
@@ -561,9 +683,14 @@ StepReport World::step(double h) {
     b.state.orientation = toQuat(q.normalized());
     b.force.setZero();
     b.torque.setZero();
-    if (!isFinite(b.state.position) || !isFinite(b.state.linear_velocity)) {
-      refuse("step: body " + std::to_string(k) + " state became non-finite (solver status " +
-             ccp::toString(report.solve.status) + ")");
+    const Quat& q_new = b.state.orientation;
+    if (!isFinite(b.state.position) || !isFinite(b.state.linear_velocity) ||
+        !isFinite(b.state.angular_velocity) ||
+        !(std::isfinite(q_new.w) && std::isfinite(q_new.x) && std::isfinite(q_new.y) &&
+          std::isfinite(q_new.z))) {
+      b.state = before;  // the last finite state; disable() zeroes the velocities
+      s.disable(static_cast<BodyId>(k));
+      report.nonfinite_bodies.push_back(static_cast<BodyId>(k));
     }
   }
   s.time += h;
@@ -574,13 +701,7 @@ void World::disableBody(BodyId body) {
   if (body < 0 || body >= numBodies() || impl_->bodies[body].kinematic) {
     refuse("disableBody: " + std::to_string(body) + " is not a dynamic body");
   }
-  Impl::Body& b = impl_->bodies[body];
-  b.disabled = true;
-  b.state.linear_velocity = {};
-  b.state.angular_velocity = {};
-  for (auto& [geom, a] : impl_->attached) {
-    if (a.body == body) dGeomDisable(geom);
-  }
+  impl_->disable(body);
 }
 
 double World::time() const {

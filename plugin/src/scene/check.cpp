@@ -777,18 +777,6 @@ std::vector<Hazard> checkScene(const Scene& scene, Method method) {
     }
   }
 
-  // --- 6. Settings the engine ignores ---------------------------------------------------------
-  if (!ode && scene.material.restitution > 0) {
-    Hazard hz;
-    hz.kind = Hazard::Kind::IgnoredSetting;
-    hz.value = scene.material.restitution;
-    hz.limit = 0;
-    hz.where = "material.restitution";
-    hz.message = "material.restitution = " + fmt(scene.material.restitution) +
-                 ": the reference solver has no restitution (every impact is inelastic)";
-    hz.safe_setting = "material.restitution = 0, or an ODE method";
-    out.push_back(hz);
-  }
   return out;
 }
 

@@ -21,6 +21,8 @@ class ReferenceSimulation final : public PartSimulation {
     s.erp = scene.solver.erp;
     s.cfm = scene.solver.cfm;
     s.default_mu = scene.material.mu;
+    s.restitution = scene.material.restitution;  // Newton's impact law, as ODE's dContactBounce
+    s.bounce_velocity = 0;                       // as the ODE engine's surface.bounce_vel
     s.solver.method = scene.solver.apgd ? ccp::Method::Apgd : ccp::Method::Pgs;
     s.solver.max_iterations = scene.solver.iterations;
     s.solver.tolerance = scene.solver.tolerance;
@@ -123,15 +125,6 @@ class ReferenceSimulation final : public PartSimulation {
       ignoreSetting(
           "solver.ode_quickstep = false: ignored by the reference solver (ODE's stepper choice)");
     }
-    // ---- Restitution: ignored by the reference world until it implements Newton's impact
-    // law (issue 7, item 3). Delete this block when reference::Settings gains restitution. ----
-    if (scene_.material.restitution > 0) {
-      std::ostringstream line;
-      line << "material.restitution = " << scene_.material.restitution
-           << ": ignored by the reference solver (its impacts are perfectly plastic)";
-      ignoreSetting(line.str());
-    }
-    // ---- end of the restitution block ----
   }
 
   TriMeshStore meshes_;  // declared before world_: destroyed after the world's space and geoms

@@ -51,10 +51,12 @@ const char* toString(Method method);
 enum class Status {
   /// No solve has produced this result.
   NotRun,
-  /// The residual is at or below Settings::tolerance (and, in Coulomb mode, the fixed point
-  /// moved less than Settings::coulomb_tolerance).
+  /// The residual is at or below Settings::tolerance (in Coulomb mode: the Coulomb residual is,
+  /// or the fixed point moved less than Settings::coulomb_tolerance after a converged inner
+  /// solve).
   Converged,
-  /// The iteration or time budget ran out first; gamma is the best iterate found.
+  /// The iteration or time budget ran out first; gamma is the best iterate found (in Coulomb
+  /// mode: the shifted outer iterate with the lowest Coulomb residual).
   MaxIterations,
   /// A non-finite value appeared during the iterations; gamma is the last finite best iterate.
   NumericalIssue,
@@ -91,9 +93,14 @@ struct Settings {
   /// Status::MaxIterations and the best iterate.
   double time_limit_s = 0.0;
   /// Outer fixed-point iterations of the true Coulomb mode (>= 0). 0 solves the convex
-  /// relaxation (the CCP). k > 0 solves up to k relaxed problems with `r_n` replaced by
-  /// `r_n + mu ||u_t||` from the previous solution, warm-started, until the added term changes by
-  /// less than coulomb_tolerance.
+  /// relaxation (the CCP). k > 0 solves up to k relaxed problems: the first with the problem's
+  /// own r (from the incoming gamma; where nothing slides it is the Coulomb solution), then,
+  /// restarting from the incoming gamma, each with `r_n` replaced by `r_n + mu ||u_t||` from the
+  /// previous solution, warm-started. It stops when the Coulomb residual (see
+  /// Result::coulomb_distance) is at or below tolerance, or when the added term changes by less
+  /// than coulomb_tolerance with a converged inner solve; otherwise (Status::MaxIterations) the
+  /// shifted iterate with the lowest Coulomb residual is returned (never the relaxed one, whose
+  /// sliding contacts separate at mu ||u_t||, unless k == 1).
   int coulomb_outer_iterations = 0;
   /// Coulomb mode stops when `||s_new - s_old|| / (1 + ||r||) <= coulomb_tolerance`, where
   /// `s_i = mu_i ||u_t,i||` (m/s) is the normal shift (>= 0, dimensionless like tolerance).
@@ -114,8 +121,9 @@ struct Result {
   int iterations = 0;
   /// Relaxed problems solved in Coulomb mode (0 when Settings::coulomb_outer_iterations == 0).
   int outer_iterations = 0;
-  /// Natural map residual of the (last) relaxed problem solved, `/(1 + ||r||)` (dimensionless
-  /// for consistent units). In Coulomb mode `r` is the shifted one of the last inner solve.
+  /// Natural map residual of the relaxed problem solved, `/(1 + ||r||)` (dimensionless for
+  /// consistent units). In Coulomb mode: of the inner solve that produced the returned gamma,
+  /// with its shifted `r`.
   double residual = std::numeric_limits<double>::quiet_NaN();
   /// Distance of `u` to the dual cones (m/s), for the problem's own `r`.
   double dual_infeasibility = std::numeric_limits<double>::quiet_NaN();
