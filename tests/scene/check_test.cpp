@@ -141,8 +141,11 @@ double stackPenetration(double ratio, int iterations, double h, double edge, Met
   s.fixtures.push_back(floorBox(0.1));
   // drawParts keeps parts spawned at t = 0 apart by their bounding spheres (sqrt(3) edge):
   // the heavy cube falls 0.8 edge onto the light one.
-  s.parts.push_back(cubes(edge, 1000, {0, 0, edge / 2}, {0, 0, edge / 2}));
-  s.parts.push_back(cubes(edge, 1000 * ratio, {0, 0, 2.3 * edge}, {0, 0, 2.3 * edge}));
+  // Densities within the scene limits (<= 1e6 kg/m^3): water-like light cubes up to a ratio of
+  // 1000, lighter ones beyond (the heavy cube then stays at 1e6 kg/m^3).
+  const double light = std::min(1000.0, 1e6 / ratio);
+  s.parts.push_back(cubes(edge, light, {0, 0, edge / 2}, {0, 0, edge / 2}));
+  s.parts.push_back(cubes(edge, light * ratio, {0, 0, 2.3 * edge}, {0, 0, 2.3 * edge}));
   s.solver.time_step = h;
   s.solver.iterations = iterations;
   s.duration = 2;
