@@ -30,8 +30,9 @@
 ///    overshoot h (approach speed before the step + in full vibration the surface speed). A
 ///    full-vibration floor is taken at its lowest position during the step;
 ///  - parts lost, counted once each: removed by the engine (below Scene::removal_height),
-///    non-finite, centre behind a measured surface by more than the part's size (tunnelled),
-///    or centre outside the case's bounds box; compared with Simulation::health().partsLost().
+///    non-finite, centre behind a measured surface by more than the part's size at the end of
+///    the run (tunnelled; a part pushed back out is only a deep penetration), or centre outside
+///    the case's bounds box; compared with Simulation::health().partsLost().
 #pragma once
 
 #include <string>
@@ -120,10 +121,17 @@ struct RunRecord {
       parts_too_fast = 0;
   long fallback_steps = 0, unconverged_steps = 0;
   std::string ignored_settings;  ///< joined with "; "
-  /// Warnings of the scene check (checkScene) for this scene and method.
+  /// Warnings of the scene check (checkScene) for this scene and method, their kinds and the
+  /// safe settings they name (joined with "; ").
   int check_warnings = 0;
-  bool pass = false;
-  std::string cause;  ///< why it failed (and the case's note)
+  std::string hazards, safe_settings;
+  /// The verdict: "pass" (within every limit), "warned" (beyond a physical limit - penetration
+  /// or energy - that the scene check named before the run: a known, documented limit), "FAIL"
+  /// (a silent failure: NaN, a blow-up past the speed bound, a lost part the run did not
+  /// report, an abort or an unexpected refusal, or a physical limit nobody warned about).
+  std::string verdict = "FAIL";
+  bool pass = false;  ///< verdict != "FAIL": nothing went wrong silently
+  std::string cause;  ///< why it is not "pass" (and the case's note)
 };
 
 /// Runs `c` through `method` and measures it; never throws (a refusal is a record).

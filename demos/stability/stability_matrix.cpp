@@ -178,6 +178,7 @@ int main(int argc, char** argv) {
       r.message = WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status))
                                       : "exit status " + std::to_string(WEXITSTATUS(status));
       r.pass = false;
+      r.verdict = "FAIL";
       r.cause = "the run crashed (" + r.message + ")";
     }
     records[child.run] = r;
@@ -186,10 +187,10 @@ int main(int argc, char** argv) {
     failed += r.pass ? 0 : 1;
     const double t = elapsed();
     std::fprintf(stderr, "[%zu/%zu] %-30s %-24s %-5s %6.1f s | elapsed %.0f s, left ~%.0f s%s%s\n",
-                 finished, runs.size(), r.case_name.c_str(), r.method.c_str(),
-                 r.pass ? "pass" : "FAIL", r.wall_seconds, t,
-                 t / double(finished) * double(runs.size() - finished), r.pass ? "" : ": ",
-                 r.pass ? "" : r.cause.substr(0, 160).c_str());
+                 finished, runs.size(), r.case_name.c_str(), r.method.c_str(), r.verdict.c_str(),
+                 r.wall_seconds, t, t / double(finished) * double(runs.size() - finished),
+                 r.verdict == "pass" ? "" : ": ",
+                 r.verdict == "pass" ? "" : r.cause.substr(0, 160).c_str());
     try {
       write();
     } catch (const std::exception& e) {

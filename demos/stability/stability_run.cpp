@@ -17,6 +17,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "rheofeed/scene/check.hpp"
 #include "stability/stability_cases.hpp"
 
 namespace rheofeed::stability {
@@ -138,9 +139,17 @@ RunRecord runCase(const StabilityCase& c, Method method, const Limits& limits) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
 
-  // ---- The scene check (issue 7 item 2). LEAD: wire checkScene(scene, method) in here:
-  //      r.check_warnings = <number of warnings it returns>;
-  r.check_warnings = 0;
+  // The scene check's warnings before the run (issue 7 item 2): a run outside the safe
+  // settings is a known limit when the check named it, a silent failure when it did not.
+  try {
+    for (const Hazard& hz : checkScene(scene, method)) {
+      ++r.check_warnings;
+      r.hazards += (r.hazards.empty() ? "" : "; ") + std::string(toString(hz.kind));
+      r.safe_settings += (r.safe_settings.empty() ? "" : "; ") + hz.safe_setting;
+    }
+  } catch (const std::exception&) {
+    // An invalid scene: makeSimulation below refuses it with the message.
+  }
 
   std::unique_ptr<Simulation> sim;
   std::vector<PartInstance> instances;
@@ -177,6 +186,10 @@ RunRecord runCase(const StabilityCase& c, Method method, const Limits& limits) {
                        p.mass * (v_s * v_s + v_corr * v_corr);
   }
 
+  // Out of the scene: beyond the engine's own scene bounds (the scene's definition of where
+  // parts may be, SceneLimits in simulation.hpp) or below the removal height.
+  Bounds bounds = sceneLimits(scene).bounds;
+  bounds.min.z = scene.removal_height;
   std::vector<char> lost(instances.size(), 0);
   // Per part: seen yet; the allowed depth: its depth at spawn (the scene put it there) and the
   // largest landing overshoot so far, h times the fastest approach of any of its points during
@@ -187,6 +200,10 @@ RunRecord runCase(const StabilityCase& c, Method method, const Limits& limits) {
   const double h_step = scene.solver.time_step;
   const double surface_normal_speed = fv ? c.surface_speed : 0.0;
   std::map<std::string, int> lost_by;
+  // Per part: the surface its centre is beyond (deeper than the part's size), empty if none.
+  // A part that comes back out (pushed back by the engine) is not lost; one still beyond a
+  // surface when the run ends is (it went through).
+  std::vector<std::string> under(instances.size());
   auto lose = [&](std::size_t i, const std::string& how) {
     lost[i] = 1;
     ++r.lost_measured;
@@ -216,20 +233,21 @@ RunRecord runCase(const StabilityCase& c, Method method, const Limits& limits) {
       const Shape& shape = instances[k].shape;
       const double size = boundingRadius(shape);
       const Vec3& x = s.position;
-      if (x.x < c.bounds_min.x || x.y < c.bounds_min.y || x.z < c.bounds_min.z ||
-          x.x > c.bounds_max.x || x.y > c.bounds_max.y || x.z > c.bounds_max.z) {
+      if (x.x < bounds.min.x || x.y < bounds.min.y || x.z < bounds.min.z || x.x > bounds.max.x ||
+          x.y > bounds.max.y || x.z > bounds.max.z) {
         lose(k, "out of bounds");
         continue;
       }
       bool through = false;
+      under[k].clear();
       for (const Surface& f : c.surfaces) {
         if (!inRegion(f, x)) continue;
         // Lowest position of a vibrating surface over the step: the smaller depth.
         const auto [n0, d0] = planeAt(f, scene, fv, t_prev);
         const auto [n1, d1] = planeAt(f, scene, fv, t);
         const double centre_depth = std::min(d0 - dot(n0, x), d1 - dot(n1, x));
-        if (centre_depth > size) {
-          lose(k, "through " + f.name);
+        if (centre_depth > size) {  // beyond the surface now; lost if it ends the run there
+          under[k] = "through " + f.name;
           through = true;
           break;
         }
@@ -279,6 +297,9 @@ RunRecord runCase(const StabilityCase& c, Method method, const Limits& limits) {
     r.message = ex.what();
   }
   finishClock();
+  for (std::size_t k = 0; k < under.size(); ++k) {
+    if (!lost[k] && !under[k].empty()) lose(k, under[k]);
+  }
   r.duration = sim->time();
   r.parts = sim->numParts();
   r.energy_ratio = r.energy_budget > 0 ? max_energy / r.energy_budget : 0;
@@ -312,24 +333,46 @@ RunRecord runCase(const StabilityCase& c, Method method, const Limits& limits) {
     fail(std::to_string(r.nonfinite_parts) + " part(s) non-finite (first: " + r.nonfinite_where +
          ")");
   }
-  if (r.max_speed > limits.speed_slack * r.speed_bound) {
-    fail("speed " + fmt(r.max_speed) + " m/s > bound " + fmt(r.speed_bound) + " m/s");
+  // Speed: beyond the bound is a physical limit when warned (pushes out of overlaps chain
+  // up); beyond kBlowUp times the bound it is a blow-up, warned or not.
+  constexpr double kBlowUp = 3;
+  if (r.max_speed > kBlowUp * limits.speed_slack * r.speed_bound) {
+    fail("speed " + fmt(r.max_speed) + " m/s > " + fmt(kBlowUp) + " x bound " + fmt(r.speed_bound) +
+         " m/s (blow-up)");
+  }
+
+  // Physical limits (ODE's, the discrete step's): a known limit when the scene check warned.
+  bool beyond_limit = false;
+  auto limit = [&](const std::string& why) {
+    beyond_limit = true;
+    addCause(r, why);
+  };
+  if (r.penetration_ratio > limits.penetration_ratio) {
+    limit("penetration beyond spawn depth and landing overshoot " +
+          fmt(r.penetration_ratio, "%.2f") + " x thinnest (" + r.penetration_where + "; deepest " +
+          fmt(r.max_penetration * 1e3) + " mm)");
+  }
+  if (r.max_speed > limits.speed_slack * r.speed_bound &&
+      r.max_speed <= kBlowUp * limits.speed_slack * r.speed_bound) {
+    limit("speed " + fmt(r.max_speed) + " m/s > bound " + fmt(r.speed_bound) + " m/s");
   }
   if (r.energy_ratio > limits.energy_slack) {
-    fail("energy x" + fmt(r.energy_ratio, "%.3g") + " of budget " + fmt(r.energy_budget) + " J");
-  }
-  if (r.penetration_ratio > limits.penetration_ratio) {
-    fail("penetration beyond spawn depth and landing overshoot " +
-         fmt(r.penetration_ratio, "%.2f") + " x thinnest (" + r.penetration_where + "; deepest " +
-         fmt(r.max_penetration * 1e3) + " mm)");
+    limit("energy x" + fmt(r.energy_ratio, "%.3g") + " of budget " + fmt(r.energy_budget) + " J");
   }
   if (r.lost_measured > r.lost_reported) {
     fail(std::to_string(r.lost_measured) + " lost (" + r.lost_how + "), " +
          std::to_string(r.lost_reported) + " reported");
+  } else if (r.lost_measured > 0) {
+    limit(std::to_string(r.lost_measured) + " lost (" + r.lost_how + "), all reported");
+  }
+  if (beyond_limit && r.check_warnings == 0) fail("no scene-check warning before the run");
+  r.verdict = !r.pass ? "FAIL" : (beyond_limit ? "warned" : "pass");
+  if (beyond_limit && r.check_warnings > 0) {
+    addCause(r, "warned: " + r.hazards + " (safe: " + r.safe_settings + ")");
   }
   // Tunnelling hint: a part at its measured top speed moves further in one step than the
   // thinnest fixture geom or part is thick.
-  if (!r.pass) {
+  if (r.verdict != "pass") {
     double thin = 1e300;
     for (const Fixture& f : scene.fixtures) {
       for (const Fixture::Geom& gm : f.geoms) {
@@ -396,8 +439,8 @@ std::string csvHeader() {
          "max_speed_mps,speed_bound_mps,energy_budget_J,energy_ratio,max_penetration_m,"
          "penetration_ratio,lost_measured,lost_reported,parts_fell,parts_through_fixture,"
          "parts_out_of_bounds,parts_nonfinite,parts_too_fast,fallback_steps,"
-         "fallback_share,unconverged_steps,check_warnings,pass,covers,message,"
-         "lost_how,ignored_settings,cause";
+         "fallback_share,unconverged_steps,check_warnings,verdict,covers,message,"
+         "lost_how,ignored_settings,hazards,safe_settings,cause";
 }
 
 std::string csvRow(const RunRecord& r) {
@@ -411,17 +454,17 @@ std::string csvRow(const RunRecord& r) {
     << r.lost_reported << ',' << r.parts_fell << ',' << r.parts_through_fixture << ','
     << r.parts_out_of_bounds << ',' << r.parts_nonfinite << ',' << r.parts_too_fast << ','
     << r.fallback_steps << ',' << g17(share) << ',' << r.unconverged_steps << ','
-    << r.check_warnings << ',' << (r.pass ? "pass" : "FAIL") << ',' << quote(r.covers) << ','
-    << quote(r.message) << ',' << quote(r.lost_how) << ',' << quote(r.ignored_settings) << ','
-    << quote(r.cause);
+    << r.check_warnings << ',' << r.verdict << ',' << quote(r.covers) << ',' << quote(r.message)
+    << ',' << quote(r.lost_how) << ',' << quote(r.ignored_settings) << ',' << quote(r.hazards)
+    << ',' << quote(r.safe_settings) << ',' << quote(r.cause);
   return o.str();
 }
 
 RunRecord parseCsvRow(const std::string& line) {
   const std::vector<std::string> f = splitCsv(line);
-  if (f.size() != 32) {
+  if (f.size() != 34) {
     throw std::runtime_error("stability row with " + std::to_string(f.size()) +
-                             " fields (32 expected): " + line.substr(0, 80));
+                             " fields (34 expected): " + line.substr(0, 80));
   }
   RunRecord r;
   std::size_t i = 0;
@@ -454,11 +497,14 @@ RunRecord parseCsvRow(const std::string& line) {
   ++i;  // fallback_share: derived
   r.unconverged_steps = l();
   r.check_warnings = n();
-  r.pass = f[i++] == "pass";
+  r.verdict = f[i++];
+  r.pass = r.verdict != "FAIL";
   r.covers = f[i++];
   r.message = f[i++];
   r.lost_how = f[i++];
   r.ignored_settings = f[i++];
+  r.hazards = f[i++];
+  r.safe_settings = f[i++];
   r.cause = f[i++];
   return r;
 }
@@ -467,13 +513,18 @@ RunRecord parseCsvRow(const std::string& line) {
 
 std::string markdownReport(const std::vector<RunRecord>& records, const std::string& header) {
   std::ostringstream o;
-  int failed = 0;
-  for (const RunRecord& r : records) failed += r.pass ? 0 : 1;
+  int failed = 0, warned = 0;
+  for (const RunRecord& r : records) {
+    failed += r.verdict == "FAIL" ? 1 : 0;
+    warned += r.verdict == "warned" ? 1 : 0;
+  }
   o << "# Stability matrix\n\n" << header << "\n\n";
-  o << records.size() << " runs, " << records.size() - failed << " pass, " << failed
-    << " fail.\n\n";
+  o << records.size() << " runs: " << records.size() - failed - warned << " pass, " << warned
+    << " beyond a physical limit that the scene check warned about, " << failed
+    << " fail (silent or unbounded).\n\n";
   o << "| case | method | h (s) | status | v max / bound (m/s) | E / budget | deepest (mm), excess "
-       "(x thinnest) | lost (ours / reported) | fallback steps | check | wall (s) | verdict |\n"
+       "(x thinnest) | lost (ours / reported) | fallback steps | check warnings | wall (s) | "
+       "verdict |\n"
     << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const RunRecord& r : records) {
     o << "| " << r.case_name << " | " << r.method << " | " << fmt(r.time_step, "%.3g") << " | "
@@ -481,19 +532,27 @@ std::string markdownReport(const std::vector<RunRecord>& records, const std::str
       << " | " << fmt(r.energy_ratio, "%.3g") << " | " << fmt(r.max_penetration * 1e3, "%.3g")
       << " (" << fmt(r.penetration_ratio, "%.2f") << ") | " << r.lost_measured << " / "
       << r.lost_reported << " | " << r.fallback_steps << " | " << r.check_warnings << " | "
-      << fmt(r.wall_seconds, "%.1f") << " | " << (r.pass ? "pass" : "**FAIL**") << " |\n";
+      << fmt(r.wall_seconds, "%.1f") << " | " << (r.verdict == "FAIL" ? "**FAIL**" : r.verdict)
+      << " |\n";
   }
-  o << "\n## Failures\n\n";
-  if (failed == 0) o << "None.\n";
-  for (const RunRecord& r : records) {
-    if (r.pass) continue;
-    std::string cause = r.cause;
-    for (char& ch : cause) {
-      if (ch == '|') ch = '/';
+  auto list = [&](const char* verdict) {
+    int n = 0;
+    for (const RunRecord& r : records) {
+      if (r.verdict != verdict) continue;
+      ++n;
+      std::string cause = r.cause;
+      for (char& ch : cause) {
+        if (ch == '|') ch = '/';
+      }
+      o << "- **" << r.case_name << "** (" << r.method << ", h = " << fmt(r.time_step, "%.3g")
+        << " s; " << r.covers << "): " << cause << "\n";
     }
-    o << "- **" << r.case_name << "** (" << r.method << ", h = " << fmt(r.time_step, "%.3g")
-      << " s; " << r.covers << "): " << cause << "\n";
-  }
+    if (n == 0) o << "None.\n";
+  };
+  o << "\n## Failures (silent or unbounded)\n\n";
+  list("FAIL");
+  o << "\n## Beyond a physical limit, warned before the run (why, and the safe settings)\n\n";
+  list("warned");
   return o.str();
 }
 

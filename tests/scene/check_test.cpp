@@ -310,8 +310,13 @@ TEST(SceneCheck, DemoScenesAreQuietAtTheirSteps) {
   const std::filesystem::path dir = std::filesystem::path(RHEOFEED_DEMO_DIR) / "scenes";
   const Scene belt = loadScene(dir / "belt_conveyor.json");
   expectQuiet(belt, Method::OdeRheonomic);
+  // The turntable's capsule pins lie on a cylinder table: the weak-collider note (ODE collides
+  // capsule against cylinder with one contact point; 10 cm capsules sank through such a table
+  // in the stability matrix, the demo's 3 cm pins did not in its 3 s run). Nothing else.
   const Scene table = loadScene(dir / "turntable.json");
-  expectQuiet(table, Method::OdeRheonomic);
+  const std::vector<Hazard> on_table = checkScene(table, Method::OdeRheonomic);
+  ASSERT_EQ(on_table.size(), 1u) << formatHazards(on_table);
+  EXPECT_EQ(on_table[0].kind, Hazard::Kind::WeakCollider);
   Scene trough = loadScene(dir / "linear_vibratory_trough.json");
   expectQuiet(trough, Method::OdeFullVibration);
   // "rheonomic runs can use 0.002" (the file's comment): the check disagrees, see the report:

@@ -7,8 +7,11 @@
 //    rotation), and the run finishes (or is refused, for the case built to be refused);
 //  - no blow-up: the fastest part stays within the physical speed bound (fastest surface,
 //    push-out cap and free fall) and the energy within the budget (initial energy plus what the
-//    surfaces and the push-out can give);
-//  - bounded penetration: at most a fifth of the part's thinnest dimension;
+//    surfaces and the push-out can give), and the penetration at most a fifth of the part's
+//    thinnest dimension - unless the scene check warned before the run that the scene is
+//    beyond a known limit (tunnelling, a mass ratio the iterations cannot hold, parts spawned
+//    into each other, a weak collider pair); then the verdict is "warned", and speeds beyond
+//    three times the bound still fail (a blow-up is never a documented limit);
 //  - every part that our measurement counts as lost (through a fixture, out of bounds,
 //    removed, non-finite) is reported by Simulation::health().
 #include <gtest/gtest.h>
@@ -55,11 +58,17 @@ TEST_P(StabilityMatrix, StaysFiniteBoundedAndReportsEveryLostPart) {
   }
   ASSERT_EQ(r.status, "finished") << r.message;
   EXPECT_EQ(r.nonfinite_parts, 0) << r.nonfinite_where;
-  EXPECT_LE(r.max_speed, limits.speed_slack * r.speed_bound);
-  EXPECT_LE(r.energy_ratio, limits.energy_slack) << "budget " << r.energy_budget << " J";
-  EXPECT_LE(r.penetration_ratio, limits.penetration_ratio)
-      << r.max_penetration << " m, " << r.penetration_where;
   EXPECT_LE(r.lost_measured, r.lost_reported) << r.lost_how;
+  // Penetration and energy stay within their physical bounds, unless the run is beyond a limit
+  // of ODE or of the discrete step (tunnelling, a mass ratio the iterations cannot hold) that
+  // the scene check named before the run: then it is a documented limit, not a silent failure.
+  if (r.check_warnings == 0) {
+    EXPECT_LE(r.max_speed, limits.speed_slack * r.speed_bound);
+    EXPECT_LE(r.energy_ratio, limits.energy_slack) << "budget " << r.energy_budget << " J";
+    EXPECT_LE(r.penetration_ratio, limits.penetration_ratio)
+        << r.max_penetration << " m, " << r.penetration_where;
+  }
+  EXPECT_NE(r.verdict, "FAIL") << r.cause;
 }
 
 std::string runName(const testing::TestParamInfo<QuickRun>& info) {

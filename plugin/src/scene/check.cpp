@@ -268,26 +268,31 @@ double sizeHigh(const Distribution& d) {
 // Mass (kg) and smallest thickness (m) of a part of family `p` with sizes `sz`.
 struct PartExtreme {
   double mass = 0, thickness = 0;
+  double size = 0;  // largest extent (m); a mesh part: its smallest bounding-box extent
 };
 PartExtreme partExtreme(const PartSpec& p, const double sz[3], std::string* note) {
   const double rho = p.density;
   switch (p.shape) {
     case Shape::Kind::Box:
-      return {rho * sz[0] * sz[1] * sz[2], std::min({sz[0], sz[1], sz[2]})};
+      return {rho * sz[0] * sz[1] * sz[2], std::min({sz[0], sz[1], sz[2]}),
+              std::max({sz[0], sz[1], sz[2]})};
     case Shape::Kind::Sphere:
-      return {rho * 4.0 / 3.0 * kPi * std::pow(sz[0], 3), 2 * sz[0]};
+      return {rho * 4.0 / 3.0 * kPi * std::pow(sz[0], 3), 2 * sz[0], 2 * sz[0]};
     case Shape::Kind::Cylinder:
-      return {rho * kPi * sz[0] * sz[0] * sz[1], std::min(2 * sz[0], sz[1])};
+      return {rho * kPi * sz[0] * sz[0] * sz[1], std::min(2 * sz[0], sz[1]),
+              std::max(2 * sz[0], sz[1])};
     case Shape::Kind::Capsule:
-      return {rho * kPi * sz[0] * sz[0] * (sz[1] + 4.0 / 3.0 * sz[0]), 2 * sz[0]};
-    case Shape::Kind::Mesh:
+      return {rho * kPi * sz[0] * sz[0] * (sz[1] + 4.0 / 3.0 * sz[0]), 2 * sz[0],
+              sz[1] + 2 * sz[0]};
+    case Shape::Kind::Mesh: {
       if (!p.mesh_data) {
         if (note) *note = " (mesh part not loaded: its mass and thickness are unknown)";
-        return {0, 0};
+        return {0, 0, 0};
       }
       if (note) *note = " (mesh part: smallest bounding-box extent, an upper bound)";
-      return {massProperties(*p.mesh_data, rho).mass * std::pow(sz[0], 3),
-              meshBoxExtent(*p.mesh_data, sz[0])};
+      const double extent = meshBoxExtent(*p.mesh_data, sz[0]);
+      return {massProperties(*p.mesh_data, rho).mass * std::pow(sz[0], 3), extent, extent};
+    }
     case Shape::Kind::Plane:
       break;
   }
@@ -442,6 +447,10 @@ const char* toString(Hazard::Kind kind) {
       return "spawn_inside_fixture";
     case Hazard::Kind::SpawnBelowRemoval:
       return "spawn_below_removal";
+    case Hazard::Kind::SpawnStreamOverlap:
+      return "spawn_stream_overlap";
+    case Hazard::Kind::WeakCollider:
+      return "weak_collider";
     case Hazard::Kind::IgnoredSetting:
       return "ignored_setting";
   }
@@ -739,9 +748,54 @@ std::vector<Hazard> checkScene(const Scene& scene, Method method) {
     }
   }
 
-  // --- 5. Spawn regions inside fixtures or below the removal height ---------------------------
+  // --- 5. Spawn regions inside fixtures or below the removal height, streams into themselves --
   for (std::size_t i = 0; i < scene.parts.size(); ++i) {
     const PartSpec& p = scene.parts[i];
+    if (p.rate > 0 && p.count > 1 && g > 0) {
+      // A part released at rest falls its own largest size s in t = sqrt(2 s / g); the next
+      // one appears 1 / rate later. When it comes sooner, and the region is narrower than s
+      // across (so the next part cannot be drawn beside the last), they overlap.
+      const PartRange r = partRange(p);
+      const double s_big = r.heavy.size;
+      const double clear_time = std::sqrt(2 * s_big / g);
+      const double interval = 1.0 / p.rate;
+      const Vec3 span = p.spawn_max - p.spawn_min;
+      const double across = std::max({std::abs(span.x), std::abs(span.y), std::abs(span.z)});
+      if (interval < clear_time && across < s_big) {
+        Hazard hz;
+        hz.kind = Hazard::Kind::SpawnStreamOverlap;
+        hz.value = interval;
+        hz.limit = clear_time;
+        hz.where = idx("parts", i) + ".rate, " + idx("parts", i) + ".spawn_min/spawn_max";
+        hz.message = idx("parts", i) + " ('" + p.name + "') spawns a part every " + fmt(interval) +
+                     " s from a region " + fmt(across) + " m across, smaller than a part (" +
+                     fmt(s_big) + " m), while a part needs " + fmt(clear_time) +
+                     " s to fall clear of the next: parts appear inside each other and are "
+                     "pushed apart at up to solver.max_correcting_velocity";
+        hz.safe_setting = idx("parts", i) + ".rate <= " + fmt(1.0 / clear_time) +
+                          " parts/s, or a spawn region at least " + fmt(s_big) + " m across";
+        out.push_back(hz);
+      }
+    }
+    if (p.shape == Shape::Kind::Capsule || p.shape == Shape::Kind::Cylinder) {  // both engines
+
+      for (const GeomInfo& gi : geoms) {
+        const Fixture::Geom& gm = scene.fixtures[gi.f].geoms[gi.g];
+        if (gm.shape.kind != Shape::Kind::Cylinder) continue;
+        Hazard hz;
+        hz.kind = Hazard::Kind::WeakCollider;
+        hz.where = idx("parts", i) + ".shape, " + geomPath(gi.f, gi.g) + ".shape";
+        hz.message = std::string(toString(p.shape)) + " parts of " + idx("parts", i) +
+                     " against the cylinder " + geomPath(gi.f, gi.g) + " (fixture '" +
+                     scene.fixtures[gi.f].name +
+                     "'): ODE 0.16 collides this pair with its general convex test (one contact "
+                     "point per pair), parts tip into the cylinder and can sink through it";
+        hz.safe_setting =
+            "a box (or a triangle mesh) for " + geomPath(gi.f, gi.g) + ", or box/sphere parts";
+        out.push_back(hz);
+        break;  // one warning per part family
+      }
+    }
     for (const GeomInfo& gi : geoms) {
       const Fixture::Geom& gm = scene.fixtures[gi.f].geoms[gi.g];
       if (!regionInsideGeom(p.spawn_min, p.spawn_max, gm)) continue;

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "rheofeed/scene/check.hpp"
 #include "rheofeed/scene/output.hpp"
 #include "rheofeed/scene/plot.hpp"
 
@@ -80,6 +81,14 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
   const long report_every = std::max(1L, steps / 100);
 
   RunMetrics m;
+  const std::vector<Hazard> hazards = checkScene(scene, method);
+  for (const Hazard& hz : hazards) {
+    m.scene_check.push_back(std::string(toString(hz.kind)) + " at " + hz.where + ": " + hz.message +
+                            " (safe: " + hz.safe_setting + ")");
+  }
+  std::fprintf(
+      stderr, "%s",
+      formatHazards(hazards, "rheofeed: " + scene.name + ", " + toString(method) + ": ").c_str());
   m.scene = scene.name;
   m.method = method;
   m.time_step = h;
@@ -244,7 +253,8 @@ std::string healthSummary(const RunHealth& h, int parts) {
                                                  {"through a fixture", h.parts_through_fixture},
                                                  {"out of bounds", h.parts_out_of_bounds},
                                                  {"non-finite", h.parts_nonfinite},
-                                                 {"too fast", h.parts_too_fast}};
+                                                 {"too fast", h.parts_too_fast},
+                                                 {"inside a fixture now", h.parts_inside_fixture}};
     const char* comma = "";
     for (const auto& [name, count] : kinds) {
       if (count == 0) continue;
@@ -321,20 +331,25 @@ std::string summaryJson(const RunMetrics& r) {
   std::snprintf(c, sizeof c,
                 ", \"health\": {\"steps\": %ld, \"parts_exited\": %d, \"parts_lost\": %d, "
                 "\"parts_fell\": %d, \"parts_through_fixture\": %d, \"parts_out_of_bounds\": %d, "
-                "\"parts_nonfinite\": %d, \"parts_too_fast\": %d, \"parts_sunk\": %d, "
+                "\"parts_nonfinite\": %d, \"parts_too_fast\": %d, \"parts_inside_fixture\": %d, "
+                "\"parts_sunk\": %d, "
                 "\"coulomb_fallback_steps\": %ld, "
                 "\"coulomb_fallback_share\": %.6g, \"solver_unconverged_steps\": %ld, "
                 "\"max_part_speed_mps\": %.6g, \"speed_bound_mps\": %.6g, \"ignored_settings\": [",
                 h.steps, h.parts_exited, h.partsLost(), h.parts_fell, h.parts_through_fixture,
-                h.parts_out_of_bounds, h.parts_nonfinite, h.parts_too_fast, h.parts_sunk,
-                h.coulomb_fallback_steps,
+                h.parts_out_of_bounds, h.parts_nonfinite, h.parts_too_fast, h.parts_inside_fixture,
+                h.parts_sunk, h.coulomb_fallback_steps,
                 h.steps > 0 ? double(h.coulomb_fallback_steps) / h.steps : 0.0,
                 h.solver_unconverged_steps, h.max_part_speed, h.speed_bound);
   std::string json = "{\"scene\": " + quoted(r.scene) + b + c;
   for (std::size_t k = 0; k < h.ignored_settings.size(); ++k) {
     json += (k ? ", " : "") + quoted(h.ignored_settings[k]);
   }
-  return json + "]}}";
+  json += "]}, \"scene_check\": [";
+  for (std::size_t k = 0; k < r.scene_check.size(); ++k) {
+    json += (k ? ", " : "") + quoted(r.scene_check[k]);
+  }
+  return json + "]}";
 }
 
 std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::string& folder,

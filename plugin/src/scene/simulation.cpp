@@ -52,7 +52,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinMargin = 1.0;             // m: smallest margin around the scene's extent
-constexpr double kTunnelCheckFraction = 0.25;  // of the smallest half-size, see above
+constexpr double kTunnelCheckFraction = 1e-3;  // of the smallest half-size, see above
 // Two crossings along one segment are distinct when they are this far apart (m): far below any
 // part or fixture size, far above the round-off of a ray test over a step.
 constexpr double kCrossingTolerance = 1e-9;
@@ -340,6 +340,38 @@ double PartSimulation::firstCrossing(const Vec3& a, const Vec3& b, Vec3* normal)
   return first;
 }
 
+bool PartSimulation::insideFixture(const Vec3& x, bool* unknown) const {
+  *unknown = false;
+  dReal box[6];
+  for (dGeomID g : fixture_geoms_) {
+    const int cls = dGeomGetClass(g);
+    if (cls != dPlaneClass) {
+      dGeomGetAABB(g, box);
+      if (x.x < box[0] || x.x > box[1] || x.y < box[2] || x.y > box[3] || x.z < box[4] ||
+          x.z > box[5]) {
+        continue;
+      }
+    }
+    switch (cls) {
+      case dBoxClass:
+        if (dGeomBoxPointDepth(g, x.x, x.y, x.z) > 0) return true;
+        break;
+      case dSphereClass:
+        if (dGeomSpherePointDepth(g, x.x, x.y, x.z) > 0) return true;
+        break;
+      case dCapsuleClass:
+        if (dGeomCapsulePointDepth(g, x.x, x.y, x.z) > 0) return true;
+        break;
+      case dPlaneClass:
+        if (dGeomPlanePointDepth(g, x.x, x.y, x.z) > 0) return true;
+        break;
+      default:
+        *unknown = true;
+    }
+  }
+  return false;
+}
+
 void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const PartState& s) {
   Track& tr = tracks_[i];
   const Vec3 to = s.position;
@@ -357,12 +389,32 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const PartS
       return;
     }
     tr.inside = true;  // the centre is inside a fixture now
+    tr.outside_point = from;
     tr.entry_point = from + forward * u;
     tr.entry_normal = dot(normal, u) < 0 ? normal : -normal;  // outward: against the motion
     return;
   }
+  bool unknown = false;
+  if (insideFixture(to, &unknown)) {
+    // Crossed a surface but is still inside a fixture (out of a floor straight into a wall that
+    // stands on it, say): still inside; the new entry is this crossing.
+    tr.entry_point = from + forward * u;
+    tr.entry_normal = dot(normal, u) < 0 ? normal : -normal;
+    return;
+  }
   tr.inside = false;
   if (dot(to - tr.entry_point, tr.entry_normal) > 0) {  // back out on the side it entered
+    // ... but it may have travelled inside the fixture past another one (a plate sunk into a
+    // belt that slides under a wall standing on it): the straight path from its last centre
+    // outside to this one then crosses that other fixture in and out.
+    const double span = norm(to - tr.outside_point);
+    const double in = firstCrossing(tr.outside_point, to),
+                 out = firstCrossing(to, tr.outside_point);
+    if (span > 0 && in + out < span - kCrossingTolerance) {
+      countLoss(i, kind, "passed under or through a fixture while sunk into another (kept)",
+                health_.parts_through_fixture, s);
+      return;
+    }
     if (!tr.sunk_counted) {
       tr.sunk_counted = true;
       ++health_.parts_sunk;
@@ -462,6 +514,10 @@ void PartSimulation::step() {
       continue;
     }
     tr.last = s;
+  }
+  health_.parts_inside_fixture = 0;
+  for (const Track& tr : tracks_) {
+    if (tr.active && tr.inside && !tr.counted) ++health_.parts_inside_fixture;
   }
   totals_ = fixtureImpulses(h);
   spawnDue();

@@ -69,11 +69,16 @@ class PartSimulation : public Simulation {
     // Centre inside a fixture: where it entered (m) and the entry surface's outward normal.
     bool inside = false;
     Vec3 entry_point, entry_normal;
+    Vec3 outside_point;  // the last centre outside before it went in (m)
   };
   // Distance (m) from a along the segment a -> b to the first fixture surface it crosses
   // (ODE ray test at the geoms' current poses); infinity when it crosses none. `normal`
   // (optional) receives the surface normal there (unit, either orientation).
   double firstCrossing(const Vec3& a, const Vec3& b, Vec3* normal = nullptr);
+  // Whether point x is inside a fixture geom whose inside ODE can test exactly (box, sphere,
+  // capsule, plane: yes/no); `unknown` is set when x lies in the bounding box of a geom it cannot
+  // test (cylinder, mesh), where the ray parity of trackCrossings decides instead.
+  bool insideFixture(const Vec3& x, bool* unknown) const;
   // The tunnelling test of part i moving from `from` to state s (simulation.cpp).
   void trackCrossings(std::size_t i, const Vec3& from, const PartState& s);
   // Takes part i out, parked at `park`, and counts it under `check` (unless counted already);

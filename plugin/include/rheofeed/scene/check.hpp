@@ -39,6 +39,14 @@ struct Hazard {
     SpawnInsideFixture,
     /// A spawn region lies below Scene::removal_height: parts are removed as they appear.
     SpawnBelowRemoval,
+    /// Parts spawned over time (PartSpec::rate > 0) from a region too small to hold two of
+    /// them side by side, faster than a part falls clear of the one before: each part appears
+    /// inside the previous one and is pushed out at up to solver.max_correcting_velocity.
+    SpawnStreamOverlap,
+    /// A part shape against a fixture shape that ODE 0.16 collides poorly: capsule or cylinder
+    /// parts on cylinder fixtures (libccd's general convex test, one contact point per pair, no
+    /// persistent support: parts tip into the fixture and sink through it).
+    WeakCollider,
     /// A setting the engine of this method does not use (e.g. restitution in the reference).
     IgnoredSetting,
   };

@@ -52,15 +52,19 @@ struct RunMetrics {
   double real_time_factor = 0;
   /// What the run lost, could not trust or ignored (simulation.hpp).
   RunHealth health;
+  /// The scene check's warnings before the run (check.hpp: kind, values, safe setting), one
+  /// formatted line each; also printed on stderr when the run starts.
+  std::vector<std::string> scene_check;
 };
 
 /// Progress report: fraction done in [0, 1].
 using Progress = std::function<void(double fraction)>;
 
-/// Runs `scene` with `method` for its duration and measures it. `progress` (optional) is called
-/// about a hundred times. Throws std::invalid_argument for an invalid scene. When the run lost
-/// parts, had reference steps it cannot trust or ignored settings (RunHealth::anything), one
-/// summary line is printed on stderr at the end (healthSummary).
+/// Runs `scene` with `method` for its duration and measures it. Before the first step the scene
+/// check (checkScene) runs and its warnings go to stderr and into RunMetrics::scene_check.
+/// `progress` (optional) is called about a hundred times. Throws std::invalid_argument for an
+/// invalid scene. When the run lost parts, had reference steps it cannot trust or ignored settings
+/// (RunHealth::anything), one summary line is printed on stderr at the end (healthSummary).
 RunMetrics measureRun(const Scene& scene, Method method, const Progress& progress = {});
 
 /// A progress printer for stderr: "label: 42 %" on one refreshed line, at most every 0.5 s.

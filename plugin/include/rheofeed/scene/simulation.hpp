@@ -60,6 +60,10 @@ struct RunHealth {
   int parts_sunk = 0;
   /// Parts removed because they left the scene bounds (SceneLimits::bounds) sideways or up.
   int parts_out_of_bounds = 0;
+  /// Parts whose centre is inside a fixture now (went in and has not come out yet): a gauge,
+  /// not a count over the run. Part of partsLost() while they are inside (a plate stuck in a
+  /// wall at the end of a run is lost; one sunk for a few steps counts only during them).
+  int parts_inside_fixture = 0;
   /// Parts whose state (position, velocity, angular velocity, orientation) became NaN or
   /// infinite; they are removed at once.
   int parts_nonfinite = 0;
@@ -81,10 +85,10 @@ struct RunHealth {
   double max_part_speed = 0;
   double speed_bound = 0;
   /// Parts lost in any way but the exit: fell + through_fixture + out_of_bounds + nonfinite +
-  /// too_fast.
+  /// too_fast, plus those inside a fixture now.
   int partsLost() const {
     return parts_fell + parts_through_fixture + parts_out_of_bounds + parts_nonfinite +
-           parts_too_fast;
+           parts_too_fast + parts_inside_fixture;
   }
   /// Whether anything was lost, not trusted or ignored.
   bool anything() const {
