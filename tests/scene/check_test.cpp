@@ -319,15 +319,14 @@ TEST(SceneCheck, DemoScenesAreQuietAtTheirSteps) {
   EXPECT_EQ(on_table[0].kind, Hazard::Kind::WeakCollider);
   Scene trough = loadScene(dir / "linear_vibratory_trough.json");
   expectQuiet(trough, Method::OdeFullVibration);
-  // "rheonomic runs can use 0.002" (the file's comment): the check disagrees, see the report:
-  // the free fall of 0.47 m from the hopper to the catch floor (3 m/s, 6.1 mm per step against
-  // 5 mm plates) and the largest / smallest plate (25.4 against a measured 20 at 30
-  // iterations). Both are real by the check's criteria; neither was run to confirm.
+  // "rheonomic runs can use 0.002" (the file's comment): the check warns about the mass ratio
+  // (largest / smallest plate 25.4 against a measured 20 at 30 iterations). The free fall of
+  // 0.47 m onto the catch floor is not a hazard: only parts that left over the end fall there
+  // (the check looks under the spawn region, where the trough is).
   trough.solver.time_step = 0.002;
   const std::vector<Hazard> at2ms = checkScene(trough, Method::OdeRheonomic);
-  ASSERT_EQ(at2ms.size(), 2u) << formatHazards(at2ms);
-  EXPECT_EQ(at2ms[0].kind, Hazard::Kind::Tunnelling);
-  EXPECT_EQ(at2ms[1].kind, Hazard::Kind::MassRatio);
+  ASSERT_EQ(at2ms.size(), 1u) << formatHazards(at2ms);
+  EXPECT_EQ(at2ms[0].kind, Hazard::Kind::MassRatio);
   Scene bowl = loadScene(dir / "bowl_feeder.json");
   expectQuiet(bowl, Method::OdeFullVibration);
   bowl.solver.time_step = 0.005;  // bowl_feeder's rheonomic step
