@@ -73,6 +73,11 @@ void planeSpace(const Vector3d& n, Vector3d& t1, Vector3d& t2) {
 
 // Below this surface speed (m/s) the friction frame is ODE's plane space, not aligned with c.
 constexpr double kMinSurfaceSpeed = 1e-12;
+// Share of |g| h (the speed gravity takes away in one step) that an unsettled Coulomb step may
+// leave as spurious separation at a pressed contact before the solver corrects its normal
+// impulses (ccp::Settings::coulomb_max_separation): a part lifted at 0.01 |g| h rises
+// (0.01 |g| h)^2 / (2 |g|) = 5e-5 |g| h^2, 5e-8 m at h = 0.01 s, and falls back within the step.
+constexpr double kSpuriousSeparationShare = 0.01;
 
 Matrix3d skew(const Vector3d& a) {
   Matrix3d m;
@@ -613,6 +618,9 @@ StepReport World::step(double h) {
       }
     }
     s.solver.settings() = cfg.solver;
+    s.solver.settings().coulomb_max_separation =
+        std::max(cfg.solver.coulomb_max_separation,
+                 kSpuriousSeparationShare * toEigen(cfg.gravity).norm() * h);
     report.solve = s.solver.solve(problem, gamma);
     // When the true-Coulomb fixed point does not settle, the solver returns its outer iterate
     // with the lowest Coulomb residual, and the step uses it. The relaxed CCP is no fallback:
