@@ -623,9 +623,10 @@ StepReport World::step(double h) {
                  kSpuriousSeparationShare * toEigen(cfg.gravity).norm() * h);
     report.solve = s.solver.solve(problem, gamma);
     // When the true-Coulomb fixed point does not settle, the solver returns its outer iterate
-    // with the lowest Coulomb residual, and the step uses it. The relaxed CCP is no fallback:
-    // it separates every sliding contact at u_n = mu |u_t| (a box on a 10 m/s belt with
-    // mu = 0.5 leaves at 5 m/s). A shifted iterate k + 1 separates a sliding contact only by
+    // with the lowest Coulomb residual, and the step uses it, normals corrected when it
+    // separates a pressed contact faster than coulomb_max_separation (solver.cpp). The relaxed CCP
+    // is no fallback: it separates every sliding contact at u_n = mu |u_t| (a box on a 10 m/s belt
+    // with mu = 0.5 leaves at 5 m/s). A shifted iterate k + 1 separates a sliding contact only by
     // mu (|u_t^(k+1)| - |u_t^(k)|), the change of slip between iterates, and the Coulomb
     // residual (reported) bounds that: with rho = 1 a pressed contact's normal velocity error is
     // at most coulomb_residual (1 + |r|) (m/s).

@@ -56,7 +56,8 @@ enum class Status {
   /// solve).
   Converged,
   /// The iteration or time budget ran out first; gamma is the best iterate found (in Coulomb
-  /// mode: the shifted outer iterate with the lowest Coulomb residual).
+  /// mode: the shifted outer iterate with the lowest Coulomb residual, its normal impulses
+  /// corrected as Settings::coulomb_max_separation says).
   MaxIterations,
   /// A non-finite value appeared during the iterations; gamma is the last finite best iterate.
   NumericalIssue,
@@ -100,7 +101,8 @@ struct Settings {
   /// Result::coulomb_distance) is at or below tolerance, or when the added term changes by less
   /// than coulomb_tolerance with a converged inner solve; otherwise (Status::MaxIterations) the
   /// shifted iterate with the lowest Coulomb residual is returned (never the relaxed one, whose
-  /// sliding contacts separate at mu ||u_t||, unless k == 1).
+  /// sliding contacts separate at mu ||u_t||, unless k == 1), with the frozen-friction normal
+  /// correction (see coulomb_max_separation) when it separates a pressed contact.
   int coulomb_outer_iterations = 0;
   /// Coulomb mode stops when `||s_new - s_old|| / (1 + ||r||) <= coulomb_tolerance`, where
   /// `s_i = mu_i ||u_t,i||` (m/s) is the normal shift (>= 0, dimensionless like tolerance).
@@ -138,7 +140,7 @@ struct Result {
   /// then carries the effect of the last shrink) or no correction was made.
   bool normal_correction_settled = false;
   /// Contacts whose friction impulse the correction set to zero (counted once per round):
-  /// after coulomb_outer_iterations shrinking rounds, a contact whose friction still exceeds
+  /// after 10 x coulomb_outer_iterations shrinking rounds, a contact whose friction still exceeds
   /// the cone of its corrected normal impulse loses its friction for the step, which ends the
   /// correction in at most nc more rounds.
   int friction_dropped_contacts = 0;
