@@ -55,10 +55,10 @@ constexpr double kLipschitzDecrease = 0.9;
 
 }  // namespace
 
-InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Settings& settings,
-                     const Deadline& deadline, Eigen::VectorXd& gamma, Workspace& ws) {
+InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Eigen::VectorXd& mu,
+                     const Settings& settings, const Deadline& deadline, Eigen::VectorXd& gamma,
+                     Workspace& ws) {
   const Eigen::Index nc = problem.numContacts();
-  const Eigen::VectorXd& mu = problem.mu;
   const double scale = 1.0 + r.norm();
   const double rho = settings.residual_rho;
   InnerOutcome out;

@@ -125,10 +125,9 @@ class MatrixFreeContacts {
 
 template <class Contacts>
 InnerOutcome pgsLoop(Contacts& contacts, const Problem& problem, const Eigen::VectorXd& r,
-                     const Settings& settings, const Deadline& deadline, Eigen::VectorXd& gamma,
-                     Workspace& ws) {
+                     const Eigen::VectorXd& mu, const Settings& settings, const Deadline& deadline,
+                     Eigen::VectorXd& gamma, Workspace& ws) {
   const Eigen::Index nc = problem.numContacts();
-  const Eigen::VectorXd& mu = problem.mu;
   const double scale = 1.0 + r.norm();
   const double rho = settings.residual_rho;
   for (Eigen::Index i = 0; i < nc; ++i) {
@@ -198,14 +197,15 @@ InnerOutcome pgsLoop(Contacts& contacts, const Problem& problem, const Eigen::Ve
 
 }  // namespace
 
-InnerOutcome runPgs(const Problem& problem, const Eigen::VectorXd& r, const Settings& settings,
-                    const Deadline& deadline, Eigen::VectorXd& gamma, Workspace& ws) {
+InnerOutcome runPgs(const Problem& problem, const Eigen::VectorXd& r, const Eigen::VectorXd& mu,
+                    const Settings& settings, const Deadline& deadline, Eigen::VectorXd& gamma,
+                    Workspace& ws) {
   if (problem.form == DelassusForm::Dense) {
     DenseContacts contacts(problem, r, ws);
-    return pgsLoop(contacts, problem, r, settings, deadline, gamma, ws);
+    return pgsLoop(contacts, problem, r, mu, settings, deadline, gamma, ws);
   }
   MatrixFreeContacts contacts(problem, r, ws);
-  return pgsLoop(contacts, problem, r, settings, deadline, gamma, ws);
+  return pgsLoop(contacts, problem, r, mu, settings, deadline, gamma, ws);
 }
 
 }  // namespace rheofeed::ccp::detail

@@ -27,10 +27,13 @@ struct Workspace {
   Eigen::VectorXd best;          // best iterate by residual
   Eigen::VectorXd coulomb_best;  // Coulomb mode: the outer iterate with the lowest Coulomb residual
   Eigen::VectorXd coulomb_start;  // Coulomb mode: the incoming gamma (start of the shift iteration)
+  Eigen::VectorXd friction;       // frozen-friction correction: gamma with its normals zeroed
+  Eigen::VectorXd r_normal;       // frozen-friction correction: r + N friction
   // Contacts (nc).
   Eigen::VectorXd eta;        // PGS block step 3 / trace(N_ii)
   Eigen::VectorXd shift;      // Coulomb mode: current s_i = mu_i ||u_t,i||
   Eigen::VectorXd shift_new;  // Coulomb mode: next s_i
+  Eigen::VectorXd zero_mu;    // frozen-friction correction: mu = 0 (the normal-only problem)
   // Generalised velocities (ndof), matrix-free only.
   Eigen::VectorXd dof_a;
   Eigen::VectorXd dof_b;
@@ -79,12 +82,17 @@ double naturalMap(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u, const 
 void projectOntoCones(Eigen::VectorXd& gamma, const Eigen::VectorXd& mu);
 
 /// Relaxed solve by block PGS. On entry `gamma` is in K; on exit it is the last iterate.
-/// `r` is the free velocity to use (the problem's or the Coulomb-shifted one).
-InnerOutcome runPgs(const Problem& problem, const Eigen::VectorXd& r, const Settings& settings,
-                    const Deadline& deadline, Eigen::VectorXd& gamma, Workspace& ws);
+/// `r` is the free velocity to use (the problem's or the Coulomb-shifted one) and `mu` the
+/// friction coefficients (the problem's, or zeros for the frozen-friction normal problem of
+/// solver.cpp); only the Delassus operator is taken from `problem`.
+InnerOutcome runPgs(const Problem& problem, const Eigen::VectorXd& r, const Eigen::VectorXd& mu,
+                    const Settings& settings, const Deadline& deadline, Eigen::VectorXd& gamma,
+                    Workspace& ws);
 
-/// Relaxed solve by APGD. On entry `gamma` is in K; on exit it is the best iterate.
-InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Settings& settings,
-                     const Deadline& deadline, Eigen::VectorXd& gamma, Workspace& ws);
+/// Relaxed solve by APGD (arguments as runPgs). On entry `gamma` is in K; on exit it is the
+/// best iterate.
+InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Eigen::VectorXd& mu,
+                     const Settings& settings, const Deadline& deadline, Eigen::VectorXd& gamma,
+                     Workspace& ws);
 
 }  // namespace rheofeed::ccp::detail

@@ -73,6 +73,11 @@ void planeSpace(const Vector3d& n, Vector3d& t1, Vector3d& t2) {
 
 // Below this surface speed (m/s) the friction frame is ODE's plane space, not aligned with c.
 constexpr double kMinSurfaceSpeed = 1e-12;
+// Share of |g| h (the speed gravity takes away in one step) that an unsettled Coulomb step may
+// leave as spurious separation at a pressed contact before the solver corrects its normal
+// impulses (ccp::Settings::coulomb_max_separation): a part lifted at 0.01 |g| h rises
+// (0.01 |g| h)^2 / (2 |g|) = 5e-5 |g| h^2, 5e-8 m at h = 0.01 s, and falls back within the step.
+constexpr double kSpuriousSeparationShare = 0.01;
 
 Matrix3d skew(const Vector3d& a) {
   Matrix3d m;
@@ -613,11 +618,15 @@ StepReport World::step(double h) {
       }
     }
     s.solver.settings() = cfg.solver;
+    s.solver.settings().coulomb_max_separation =
+        std::max(cfg.solver.coulomb_max_separation,
+                 kSpuriousSeparationShare * toEigen(cfg.gravity).norm() * h);
     report.solve = s.solver.solve(problem, gamma);
     // When the true-Coulomb fixed point does not settle, the solver returns its outer iterate
-    // with the lowest Coulomb residual, and the step uses it. The relaxed CCP is no fallback:
-    // it separates every sliding contact at u_n = mu |u_t| (a box on a 10 m/s belt with
-    // mu = 0.5 leaves at 5 m/s). A shifted iterate k + 1 separates a sliding contact only by
+    // with the lowest Coulomb residual, and the step uses it, normals corrected when it
+    // separates a pressed contact faster than coulomb_max_separation (solver.cpp). The relaxed CCP
+    // is no fallback: it separates every sliding contact at u_n = mu |u_t| (a box on a 10 m/s belt
+    // with mu = 0.5 leaves at 5 m/s). A shifted iterate k + 1 separates a sliding contact only by
     // mu (|u_t^(k+1)| - |u_t^(k)|), the change of slip between iterates, and the Coulomb
     // residual (reported) bounds that: with rho = 1 a pressed contact's normal velocity error is
     // at most coulomb_residual (1 + |r|) (m/s).

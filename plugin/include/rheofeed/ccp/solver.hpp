@@ -56,7 +56,8 @@ enum class Status {
   /// solve).
   Converged,
   /// The iteration or time budget ran out first; gamma is the best iterate found (in Coulomb
-  /// mode: the shifted outer iterate with the lowest Coulomb residual).
+  /// mode: the shifted outer iterate with the lowest Coulomb residual, its normal impulses
+  /// corrected as Settings::coulomb_max_separation says).
   MaxIterations,
   /// A non-finite value appeared during the iterations; gamma is the last finite best iterate.
   NumericalIssue,
@@ -100,11 +101,18 @@ struct Settings {
   /// Result::coulomb_distance) is at or below tolerance, or when the added term changes by less
   /// than coulomb_tolerance with a converged inner solve; otherwise (Status::MaxIterations) the
   /// shifted iterate with the lowest Coulomb residual is returned (never the relaxed one, whose
-  /// sliding contacts separate at mu ||u_t||, unless k == 1).
+  /// sliding contacts separate at mu ||u_t||, unless k == 1), with the frozen-friction normal
+  /// correction (see coulomb_max_separation) when it separates a pressed contact.
   int coulomb_outer_iterations = 0;
   /// Coulomb mode stops when `||s_new - s_old|| / (1 + ||r||) <= coulomb_tolerance`, where
   /// `s_i = mu_i ||u_t,i||` (m/s) is the normal shift (>= 0, dimensionless like tolerance).
   double coulomb_tolerance = 1e-8;
+  /// Coulomb mode, when the fixed point does not settle: the best iterate is returned as is when
+  /// no contact that carries a normal impulse separates faster than this (m/s, >= 0; infinity
+  /// disables the correction); otherwise its normal impulses are corrected (frozen-friction
+  /// normal correction, solver.cpp): Signorini's law is restored with the best iterate's friction
+  /// shrunk into the cone of the new normal impulses, so that friction cannot launch a contact.
+  double coulomb_max_separation = 0.0;
 
   /// Empty when the settings are usable, else a message naming the bad field and its value.
   std::string validate() const;
@@ -121,6 +129,24 @@ struct Result {
   int iterations = 0;
   /// Relaxed problems solved in Coulomb mode (0 when Settings::coulomb_outer_iterations == 0).
   int outer_iterations = 0;
+  /// Coulomb mode, when the fixed point did not settle: rounds of the frozen-friction normal
+  /// correction applied to the best iterate (normal-only solves, each followed by shrinking the
+  /// friction into the cone of the new normal impulses; see Settings::coulomb_outer_iterations).
+  /// 0 otherwise.
+  int normal_correction_rounds = 0;
+  /// True when the last correction round shrank no friction impulse: the returned gamma then
+  /// satisfies Signorini's law (gamma_n >= 0, u_n >= 0, gamma_n u_n = 0, to the inner
+  /// tolerance) with friction in the cone. False when the rounds ran out (the normal velocity
+  /// then carries the effect of the last shrink) or no correction was made.
+  bool normal_correction_settled = false;
+  /// Contacts whose friction impulse the correction set to zero (counted once per round):
+  /// after 10 x coulomb_outer_iterations shrinking rounds, a contact whose friction still exceeds
+  /// the cone of its corrected normal impulse loses its friction for the step, which ends the
+  /// correction in at most nc more rounds.
+  int friction_dropped_contacts = 0;
+  /// Coulomb mode, when the fixed point did not settle: the largest normal velocity (m/s) of a
+  /// contact carrying a normal impulse in the best iterate, before any correction (0 otherwise).
+  double best_iterate_separation = 0.0;
   /// Natural map residual of the relaxed problem solved, `/(1 + ||r||)` (dimensionless for
   /// consistent units). In Coulomb mode: of the inner solve that produced the returned gamma,
   /// with its shifted `r`.

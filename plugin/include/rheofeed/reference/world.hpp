@@ -137,7 +137,11 @@ struct StepReport {
   /// True when the true-Coulomb fixed point (Settings::solver.coulomb_outer_iterations > 0) did
   /// not settle (solve.status MaxIterations) and the step used the solver's best Coulomb
   /// iterate, the one with the lowest Coulomb residual (never the relaxed CCP's separation
-  /// at mu |u_t|). Count it over a run to know how often the law was only approximated.
+  /// at mu |u_t|). If that iterate separates a contact carrying a normal impulse faster than
+  /// max(solver.coulomb_max_separation, 0.01 |g| h) (m/s), its normal impulses are corrected
+  /// with its friction frozen and shrunk into the cone (ccp::Result::normal_correction_rounds,
+  /// friction_dropped_contacts, best_iterate_separation), so friction cannot launch a part.
+  /// Count it over a run to know how often the law was only approximated.
   bool coulomb_fallback = false;
   /// Natural map residual of the true Coulomb law for the impulses applied this step
   /// (dimensionless, scaled by 1 + |r| as ccp::Result::coulomb_distance; NaN without contacts).
