@@ -22,6 +22,9 @@ constexpr double kPileMeanSpeedTolerance = 5e-3;  // m/s
 // carry the weight; ERP recovery of residual depth adds a little.
 constexpr double kWeightTolerance = 0.01;  // relative
 
+// A part whose centre is this far below the belt's top (m) has fallen off it.
+constexpr double kOffBeltDepth = 0.05;
+
 double totalWeightImpulse(const Scene& s, const RunSummary& r) {
   (void)r;
   double mass = 0;
@@ -107,11 +110,26 @@ TEST(OdeVsReference, PileOnBeltMovesAtBeltSpeedAndFixturesCarryItsWeight) {
   const double v = 0.3;
   const Scene s = pileOnBeltScene(50, v);
   const Comparison c = compare(s, Method::OdeRheonomic, Method::ReferenceRheonomic);
-  const double weight = totalWeightImpulse(s, c.a);
+  const std::vector<PartInstance> parts = drawParts(s);
   for (const RunSummary* r : {&c.a, &c.b}) {
     SCOPED_TRACE(toString(r->method));
     EXPECT_EQ(r->parts, 50);
     EXPECT_NEAR(r->mean_velocity.x, v, kPileMeanSpeedTolerance);
+    // The fixtures carry the weight of the parts still on the belt (top at z = 0): a falling
+    // pile is chaotic, and a part knocked over the belt's edge (seen in the reference: deflected
+    // by a tilted box at 1.6 m/s, off the 0.5 m belt at t = 0.4 s) is no longer carried.
+    double carried_mass = 0;
+    int off_belt = 0;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      const PartState& p = r->states.at(i);
+      if (p.active && p.position.z > -kOffBeltDepth) {
+        carried_mass += parts[i].mass;
+      } else {
+        ++off_belt;
+      }
+    }
+    EXPECT_LE(off_belt, 2) << "more than a stray part or two left the belt";
+    const double weight = carried_mass * kGravity * s.solver.time_step;
     EXPECT_NEAR(r->normal_impulse, weight, kWeightTolerance * weight);
   }
 }

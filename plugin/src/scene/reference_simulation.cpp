@@ -61,7 +61,9 @@ class ReferenceSimulation final : public PartSimulation {
       std::ostringstream line;
       line << "step from t = " << time() << " s: the true-Coulomb fixed point did not settle in "
            << scene_.solver.coulomb_iterations << " iterations (" << report.contacts
-           << " contacts); the step used the relaxed CCP";
+           << " contacts); the step used the iterate with the lowest Coulomb residual ("
+           << report.coulomb_residual << "), normal impulses re-solved so that friction launches "
+           << "nothing";
       reportFirst("Coulomb fallback step", line.str());
     }
     if (report.contacts > 0 && report.solve.status != ccp::Status::Converged) {
