@@ -161,6 +161,7 @@ RunRecord runCase(const StabilityCase& c, Method method, const Limits& limits) {
     r.message = e.what();
     finishClock();
     r.pass = c.expect_refusal;
+    r.verdict = r.pass ? "pass" : "FAIL";
     addCause(r, c.expect_refusal ? "refused as expected" : "refused unexpectedly");
     if (!c.note.empty()) addCause(r, c.note);
     return r;
@@ -522,6 +523,29 @@ std::string markdownReport(const std::vector<RunRecord>& records, const std::str
   o << records.size() << " runs: " << records.size() - failed - warned << " pass, " << warned
     << " beyond a physical limit that the scene check warned about, " << failed
     << " fail (silent or unbounded).\n\n";
+  // One line per case: its verdict per method (the README's table).
+  o << "## By case\n\n| case | what it covers | ODE rheonomic | reference rheonomic | ODE full "
+       "vibration | reference full vibration |\n|---|---|---|---|---|---|\n";
+  const char* methods[] = {"ode_rheonomic", "reference_rheonomic", "ode_full_vibration",
+                           "reference_full_vibration"};
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    if (k > 0 && records[k].case_name == records[k - 1].case_name) continue;
+    o << "| " << records[k].case_name << " | " << records[k].covers;
+    for (const char* m : methods) {
+      std::string cell = "-";
+      for (std::size_t j = k; j < records.size() && records[j].case_name == records[k].case_name;
+           ++j) {
+        if (records[j].method != m) continue;
+        cell = records[j].verdict == "FAIL" ? "**FAIL**" : records[j].verdict;
+        if (records[j].lost_reported > 0) {
+          cell += " (" + std::to_string(records[j].lost_reported) + " lost)";
+        }
+      }
+      o << " | " << cell;
+    }
+    o << " |\n";
+  }
+  o << "\n## All runs\n\n";
   o << "| case | method | h (s) | status | v max / bound (m/s) | E / budget | deepest (mm), excess "
        "(x thinnest) | lost (ours / reported) | fallback steps | check warnings | wall (s) | "
        "verdict |\n"
