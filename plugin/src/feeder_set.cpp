@@ -16,6 +16,9 @@ namespace {
 // one to a few feeders). More feeders switch to the hash map.
 constexpr std::size_t kLinearLookupLimit = 8;
 constexpr int kDiagnosticKinds = 6;
+// A law accepted at |speed| = kMaxSurfaceSpeed may give |c_t| a few roundings above it (the
+// belt's projection and renormalisation): the per-contact test allows this relative slack.
+constexpr double kContactSpeedLimit = kMaxSurfaceSpeed * (1.0 + 1e-12);
 
 // The body of a contact's geom; 0 for a static geom and for a null geom (a hand-made contact
 // against the static environment: ODE's contact joint never reads the geoms).
@@ -405,7 +408,7 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
           }
           // Non-finite, or beyond what ODE's motion1 can take (motion_law.hpp, Limits); the
           // norm of finite components may overflow to inf, which the test catches as well.
-          if (!isFinite(value) || !(norm(value) <= kMaxSurfaceSpeed)) {
+          if (!isFinite(value) || !(norm(value) <= kContactSpeedLimit)) {
             finite = false;
             ++f->stats.law_not_finite;
             s.report(*f, DiagnosticKind::LawNotFinite, [&] {

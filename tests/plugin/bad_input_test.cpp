@@ -518,6 +518,15 @@ TEST_F(BadInput, BeltSpeedBeyondTheLimitIsRefusedWithValueAndRange) {
   EXPECT_EQ(c.surface.motion1, kMaxSurfaceSpeed);
   // ODE makes the part node0 (the static feeder has no body): (v_part - 0) . fdir1 = motion1.
   EXPECT_EQ(c.fdir1[0], 1.0);
+  // A slanted belt at the limit is driven too, whatever the rounding of its projection.
+  set_.setLaw(static_geom_, MotionLaw::belt({1, 1, 0.3}, kMaxSurfaceSpeed));
+  c = contact(static_geom_, part_);
+  driveOne(set_, c);
+  EXPECT_TRUE(c.surface.mode & dContactMotion1);
+  // The belt's normalisation, projection and renormalisation: a few roundings of 2.2e-16.
+  constexpr double kFewRoundings = 8 * std::numeric_limits<double>::epsilon();
+  EXPECT_NEAR(c.surface.motion1 / kMaxSurfaceSpeed, 1.0, kFewRoundings);
+  EXPECT_EQ(set_.stats(static_geom_).law_not_finite, 0u);
 }
 
 TEST_F(BadInput, TranslationSpeedBeyondTheLimitIsRefusedByItsLength) {
