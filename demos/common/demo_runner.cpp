@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include "rheofeed/scene/calibration.hpp"
@@ -16,6 +18,23 @@ namespace rheofeed::demo {
 
 using namespace rheofeed::scene;
 
+namespace {
+
+// A number as a user typed it back (std::to_string prints 1e-12 as "0.000000").
+std::string number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+// Where a run's time step comes from, for the messages and the line printed before each run.
+struct StepChoice {
+  double time_step;
+  std::string source;
+};
+
+}  // namespace
+
 int runDemo(int argc, char** argv, const std::string& name, const std::string& description,
             Scene scene, const DemoOptions& options) {
   std::string scene_file, out_dir = "out/" + name;
@@ -23,10 +42,22 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
   std::vector<std::string> methods = {"ode_rheonomic"};
   bool classical = false;
   CLI::App app{description};
-  app.add_option("--scene", scene_file, "scene file (JSON) instead of the built-in scene");
-  app.add_option("--duration", duration, "simulated time (s), overrides the scene");
-  app.add_option("--dt", dt, "time step of the rheonomic runs (s), overrides the scene");
-  app.add_option("--out", out_dir, "output folder");
+  app.add_option("--scene", scene_file,
+                 "scene file (JSON, a regular file) instead of the built-in scene");
+  CLI::Option* duration_option = app.add_option(
+      "--duration", duration,
+      "simulated time (s), overrides the scene: finite, > 0, at least one time step and at most "
+      "1e9 steps of every run");
+  CLI::Option* dt_option = app.add_option(
+      "--dt", dt,
+      "time step (s) of the RHEONOMIC runs only (ode_rheonomic, reference_rheonomic); "
+      "full-vibration runs always take the scene's solver.time_step. Without --dt a rheonomic "
+      "run takes " +
+          number(options.rheonomic_time_step) +
+          " s when the scene has a vibrating feeder, else the scene's solver.time_step. Finite, "
+          "in the scene's range [1e-6, 1] s. Each run prints the step it takes and where it "
+          "comes from");
+  app.add_option("--out", out_dir, "output folder (not empty)");
   app.add_option("--method", methods,
                  "methods to run: ode_rheonomic, ode_full_vibration, reference_rheonomic, "
                  "reference_full_vibration (repeat or list)")
@@ -37,17 +68,32 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
   CLI11_PARSE(app, argc, argv);
 
   try {
+    // Every input is checked here, before any run or calibration starts.
     if (!scene_file.empty()) scene = loadScene(scene_file);
-    if (dt != 0 && (!(dt > 0) || !std::isfinite(dt))) {
-      throw std::invalid_argument("--dt = " + std::to_string(dt) + ": must be > 0 (s)");
+    if (out_dir.empty()) {
+      throw std::invalid_argument("--out \"\": must name an output folder (not empty)");
     }
-    if (duration != 0) {
+    const bool dt_given = dt_option->count() > 0;
+    if (dt_given && (!(dt > 0) || !std::isfinite(dt))) {
+      throw std::invalid_argument("--dt = " + number(dt) +
+                                  " s: must be a finite number > 0 (s), in the scene's range "
+                                  "[1e-6, 1] s");
+    }
+    if (duration_option->count() > 0) {
       if (!(duration > 0) || !std::isfinite(duration)) {
-        throw std::invalid_argument("--duration = " + std::to_string(duration) + ": must be > 0");
+        throw std::invalid_argument("--duration = " + number(duration) +
+                                    " s: must be a finite number > 0 (s)");
       }
       scene.duration = duration;
     }
-    scene.validate();
+    try {
+      scene.validate();
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(
+          std::string(scene_file.empty() ? "built-in scene" : "scene " + scene_file) +
+          (duration_option->count() > 0 ? " with --duration " + number(duration) + " s" : "") +
+          ": " + e.what());
+    }
     std::vector<Method> chosen;
     for (const std::string& m : methods) {
       bool found = false;
@@ -60,9 +106,43 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
       }
       if (!found) throw std::invalid_argument("--method " + m + ": unknown method");
     }
+    bool any_rheonomic = false;
+    for (Method m : chosen) any_rheonomic = any_rheonomic || !isFullVibration(m);
+    if (dt_given && !any_rheonomic) {
+      throw std::invalid_argument(
+          "--dt " + number(dt) +
+          " s applies to the rheonomic methods only (ode_rheonomic, reference_rheonomic), and "
+          "none was chosen: full-vibration runs take the scene's solver.time_step (" +
+          number(scene.solver.time_step) + " s); drop --dt or change the scene");
+    }
+
+    // Each run's scene, validated now: a time step, duration or sampling that would take no
+    // step, no sample or too many steps is refused before anything runs.
+    const double full_step = scene.solver.time_step;
+    std::vector<std::pair<Scene, StepChoice>> runs;
+    for (Method m : chosen) {
+      Scene s = scene;
+      StepChoice step{full_step, "the scene's solver.time_step"};
+      if (!isFullVibration(m)) {
+        if (dt_given) {
+          step = {dt, "--dt"};
+        } else if (scene.hasVibration()) {
+          step = {options.rheonomic_time_step, "this demo's rheonomic default"};
+        }
+        s.solver.time_step = step.time_step;
+        s.outputs.sample_interval = std::max(s.outputs.sample_interval, s.solver.time_step);
+      }
+      try {
+        s.validate();
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string("method ") + toString(m) +
+                                    " at h = " + number(step.time_step) + " s (" + step.source +
+                                    "), duration " + number(s.duration) + " s: " + e.what());
+      }
+      runs.emplace_back(std::move(s), step);
+    }
 
     // A rheonomic run of a vibrating feeder needs its drift field: calibrate it once.
-    const double full_step = scene.solver.time_step;
     bool need_calibration = false;
     for (Method m : chosen) need_calibration = need_calibration || !isFullVibration(m);
     for (std::size_t i = 0; i < scene.fixtures.size() && need_calibration; ++i) {
@@ -90,16 +170,14 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
         "steps |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
         unit.c_str());
     std::vector<std::pair<std::string, std::string>> blocks;
-    for (Method m : chosen) {
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      const Method m = chosen[k];
+      // The validated scene of this run, with the drift field calibrated above.
       Scene s = scene;
-      if (!isFullVibration(m)) {
-        s.solver.time_step =
-            dt > 0 ? dt
-                   : (scene.hasVibration() ? options.rheonomic_time_step : scene.solver.time_step);
-        s.outputs.sample_interval = std::max(s.outputs.sample_interval, s.solver.time_step);
-      } else {
-        s.solver.time_step = full_step;
-      }
+      s.solver.time_step = runs[k].first.solver.time_step;
+      s.outputs.sample_interval = runs[k].first.outputs.sample_interval;
+      std::fprintf(stderr, "%s: %s runs at h = %s s (%s)\n", name.c_str(), toString(m),
+                   number(s.solver.time_step).c_str(), runs[k].second.source.c_str());
       const RunMetrics r = measureRun(s, m, stderrProgress(name + " " + toString(m)));
       writeRunOutputs(r, out_dir, toString(m));
       blocks.emplace_back(toString(m), seriesCsv(r));

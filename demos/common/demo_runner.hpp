@@ -20,8 +20,15 @@ struct DemoOptions {
 };
 
 /// Parses the demo's command line (--scene, --duration, --dt, --out, --method, --classical),
-/// runs the scene and prints a summary. Returns the process exit code: 0 on success, 2 on bad
-/// input (message on stderr), CLI11's own codes for a malformed command line.
+/// runs the scene and prints a summary. `--dt` sets the time step of the rheonomic runs only
+/// (full-vibration runs keep the scene's solver.time_step; --dt with only full-vibration
+/// methods is refused), and every run prints its step and where it comes from. Every input is
+/// checked before anything runs or calibrates: the scene file (a regular file), --out (not
+/// empty), --dt and --duration (finite, > 0), and the scene of every chosen run after the
+/// command-line overrides (Scene::validate: step range, at most 1e9 steps, a sample interval
+/// and warm-up within the duration). Returns the process exit code: 0 on success, 2 on bad
+/// input (message on stderr naming the value, where it came from and the allowed range),
+/// CLI11's own codes for a malformed command line.
 int runDemo(int argc, char** argv, const std::string& name, const std::string& description,
             scene::Scene builtin, const DemoOptions& options = {});
 

@@ -165,6 +165,23 @@ int rfFeederSetBeginStepDt(rfFeederSetID set, double time, double step) {
 
 int rfFeederSetDriveContacts(rfFeederSetID set, dContact* contacts, int count) {
   if (!set) return rfErrorInvalidArgument;
+  // No allocation on the good path: the near callback calls this for every geom pair.
+  if (count < 0 || (count > 0 && !contacts)) {
+    // The C++ call reports it through the diagnostic function and counts it.
+    set->set.driveContacts(contacts, count);
+    try {
+      set->last_error = count < 0 ? "rfFeederSetDriveContacts: count = " + std::to_string(count) +
+                                        " is negative: must be in [0, number of contacts]"
+                                  : "rfFeederSetDriveContacts: contacts is a null pointer with "
+                                    "count = " +
+                                        std::to_string(count) +
+                                        ": a count > 0 needs an array of that many contacts";
+    } catch (...) {
+      // Out of memory for the message: the code still says what happened.
+    }
+    return rfErrorInvalidArgument;
+  }
+  if (!set->last_error.empty()) set->last_error.clear();
   return set->set.driveContacts(contacts, count);
 }
 

@@ -36,10 +36,25 @@ void ContactCollider::clearJoints() {
   feedback_used_ = 0;
 }
 
+void ContactCollider::rethrowPendingError() {
+  if (!error_) return;
+  std::exception_ptr error = std::move(error_);
+  error_ = nullptr;
+  std::rethrow_exception(error);
+}
+
 void ContactCollider::collide(dSpaceID space, double time, double step) {
+  rethrowPendingError();           // an error of a manual pass is not lost
   feeders_.beginStep(time, step);  // first: a refused time or step leaves everything as it was
   clearJoints();
   collideWithin(space);
+  if (error_) {
+    // The pass stopped at the first exception: drop its partial joints and records, then
+    // throw it here, outside ODE.
+    clearJoints();
+    feeders_.records().clear();
+    rethrowPendingError();
+  }
 }
 
 void ContactCollider::collideWithin(dSpaceID space) {
@@ -47,7 +62,7 @@ void ContactCollider::collideWithin(dSpaceID space) {
   // nearCallback), then the pairs inside each sub-space, each exactly once.
   dSpaceCollide(space, this, &ContactCollider::nearCallback);
   const int count = dSpaceGetNumGeoms(space);
-  for (int i = 0; i < count; ++i) {
+  for (int i = 0; i < count && !error_; ++i) {
     dGeomID child = dSpaceGetGeom(space, i);
     if (dGeomIsSpace(child)) collideWithin(reinterpret_cast<dSpaceID>(child));
   }
@@ -55,11 +70,17 @@ void ContactCollider::collideWithin(dSpaceID space) {
 
 void ContactCollider::nearCallback(void* data, dGeomID o1, dGeomID o2) {
   auto* self = static_cast<ContactCollider*>(data);
-  if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) {
-    dSpaceCollide2(o1, o2, data, &ContactCollider::nearCallback);
-    return;
+  if (self->error_) return;  // the pass already failed: no more work
+  try {
+    if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) {
+      dSpaceCollide2(o1, o2, data, &ContactCollider::nearCallback);
+      return;
+    }
+    self->handlePair(o1, o2);
+  } catch (...) {
+    // ODE's frames must not be unwound: keep the first error for collide() to rethrow.
+    if (!self->error_) self->error_ = std::current_exception();
   }
-  self->handlePair(o1, o2);
 }
 
 void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {

@@ -15,7 +15,10 @@ namespace {
 // Up to this many feeders a linear scan over a contiguous array beats hashing (the common case:
 // one to a few feeders). More feeders switch to the hash map.
 constexpr std::size_t kLinearLookupLimit = 8;
-constexpr int kDiagnosticKinds = 4;
+constexpr int kDiagnosticKinds = 6;
+// A law accepted at |speed| = kMaxSurfaceSpeed may give |c_t| a few roundings above it (the
+// belt's projection and renormalisation): the per-contact test allows this relative slack.
+constexpr double kContactSpeedLimit = kMaxSurfaceSpeed * (1.0 + 1e-12);
 
 // The body of a contact's geom; 0 for a static geom and for a null geom (a hand-made contact
 // against the static environment: ODE's contact joint never reads the geoms).
@@ -51,6 +54,10 @@ const char* toString(DiagnosticKind kind) {
       return "law_not_finite";
     case DiagnosticKind::ForceCapFriction:
       return "force_cap_friction";
+    case DiagnosticKind::LawThrew:
+      return "law_threw";
+    case DiagnosticKind::InvalidCall:
+      return "invalid_call";
   }
   return "unknown";
 }
@@ -76,6 +83,8 @@ struct FeederSet::Impl {
   std::uint64_t step = 0;    // counts beginStep calls: every law is refrozen once per step
   std::vector<ContactRecord> records;
   std::function<void(const Diagnostic&)> handler;
+  std::uint64_t invalid_calls = 0;
+  bool invalid_call_reported = false;
 
   Feeder* find(dGeomID geom) const {
     if (feeders.size() <= kLinearLookupLimit) {
@@ -126,9 +135,12 @@ struct FeederSet::Impl {
     return f.frozen;
   }
 
-  void report(Feeder& f, DiagnosticKind kind, const std::string& message) noexcept {
+  // Reports `message()` (a callable building the text, so that building it cannot throw out
+  // either) through the handler, or prints the first report of each kind per feeder.
+  template <class Message>
+  void report(Feeder& f, DiagnosticKind kind, Message&& message) noexcept {
     try {
-      Diagnostic d{kind, f.geom, geomName(f.geom) + ": " + message};
+      Diagnostic d{kind, f.geom, geomName(f.geom) + ": " + message()};
       if (handler) {
         handler(d);
       } else if (!f.reported[static_cast<int>(kind)]) {
@@ -141,6 +153,46 @@ struct FeederSet::Impl {
       // A diagnostic must never unwind into ODE.
     }
     f.reported[static_cast<int>(kind)] = true;
+  }
+
+  // A driveContacts call with bad arguments: counted, reported (no feeder involved).
+  void reportInvalidCall(const dContact* contacts, int count) noexcept {
+    ++invalid_calls;
+    try {
+      std::ostringstream out;
+      out << "rheofeed::FeederSet::driveContacts: ";
+      if (count < 0) {
+        out << "count = " << count << " is negative: must be in [0, number of contacts]";
+      } else {
+        out << "contacts = " << static_cast<const void*>(contacts)
+            << " is null with count = " << count
+            << ": a count > 0 needs an array of that many contacts";
+      }
+      out << "; nothing driven, 0 returned (caller bug)";
+      Diagnostic d{DiagnosticKind::InvalidCall, nullptr, out.str()};
+      if (handler) {
+        handler(d);
+      } else if (!invalid_call_reported) {
+        std::fprintf(stderr,
+                     "rheofeed [%s]: %s (further reports of this kind are counted in "
+                     "FeederSet::invalidCalls)\n",
+                     toString(d.kind), d.message.c_str());
+      }
+    } catch (...) {
+      // A diagnostic must never unwind into ODE.
+    }
+    invalid_call_reported = true;
+  }
+
+  // The message of the exception being handled (inside a catch block only).
+  static std::string describeCurrent() {
+    try {
+      throw;
+    } catch (const std::exception& e) {
+      return e.what();
+    } catch (...) {
+      return "an exception that is not a std::exception";
+    }
   }
 
   static void wake(dBodyID body, Feeder& f) {
@@ -282,7 +334,11 @@ double FeederSet::time() const {
 
 int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
   Impl& s = *impl_;
-  if (!contacts || count <= 0 || s.feeders.empty()) return count < 0 ? 0 : count;
+  if (count < 0 || (count > 0 && !contacts)) {
+    s.reportInvalidCall(contacts, count);
+    return 0;
+  }
+  if (count == 0 || s.feeders.empty()) return count;
   const Options& opt = s.options;
 
   // Contacts of one dCollide call share their geoms: look the pair up once.
@@ -309,7 +365,7 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
     if (!Impl::contactValid(c)) {
       ++primary.stats.invalid_contacts;
       s.report(primary, DiagnosticKind::InvalidContact,
-               Impl::contactProblem(c) + "; contact removed");
+               [&] { return Impl::contactProblem(c) + "; contact removed"; });
       continue;
     }
 
@@ -330,31 +386,51 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
     bool finite = true;
     for (Impl::Feeder* f : {f_first, f_second}) {
       if (!f) continue;
-      const StepLaw& law = s.frozen(*f);
       Vec3 value;
-      if (!law.finite()) {
-        finite = false;
-        ++f->stats.law_not_finite;
-        s.report(*f, DiagnosticKind::LawNotFinite, law.problem() + "; contact left undriven");
-      } else {
-        value = law.tangentialVelocity(p, n);
-        // A secant law carries the body on the other side of the contact rigidly; it is then
-        // evaluated again. (Written this way because the if/else and ?: forms made every belt
-        // and translation contact ~15 ns slower with GCC 12 -O3, measured.)
-        if (law.usesCarriedPoint()) {
-          if (const dBodyID carried = f == f_first ? b_second : b_first) {
-            value = law.tangentialVelocity(p, n, toVec3(dBodyGetPosition(carried)));
+      // User functions (field, twist function, profile) run in here: whatever they throw is
+      // caught, and the contact is left undriven (no exception may unwind into ODE).
+      try {
+        const StepLaw& law = s.frozen(*f);
+        if (!law.finite()) {
+          finite = false;
+          ++(law.threw() ? f->stats.law_threw : f->stats.law_not_finite);
+          s.report(*f, law.threw() ? DiagnosticKind::LawThrew : DiagnosticKind::LawNotFinite,
+                   [&] { return law.problem() + "; contact left undriven"; });
+        } else {
+          value = law.tangentialVelocity(p, n);
+          // A secant law carries the body on the other side of the contact rigidly; it is then
+          // evaluated again. (Written this way because the if/else and ?: forms made every belt
+          // and translation contact ~15 ns slower with GCC 12 -O3, measured.)
+          if (law.usesCarriedPoint()) {
+            if (const dBodyID carried = f == f_first ? b_second : b_first) {
+              value = law.tangentialVelocity(p, n, toVec3(dBodyGetPosition(carried)));
+            }
+          }
+          // Non-finite, or beyond what ODE's motion1 can take (motion_law.hpp, Limits); the
+          // norm of finite components may overflow to inf, which the test catches as well.
+          if (!isFinite(value) || !(norm(value) <= kContactSpeedLimit)) {
+            finite = false;
+            ++f->stats.law_not_finite;
+            s.report(*f, DiagnosticKind::LawNotFinite, [&] {
+              std::ostringstream out;
+              out << "law gave surface velocity (" << value.x << ", " << value.y << ", " << value.z
+                  << ") m/s at p = (" << p.x << ", " << p.y << ", " << p.z << "), t = " << s.time
+                  << ": not finite or beyond the limit |c_t| <= " << kMaxSurfaceSpeed
+                  << " m/s; contact left undriven";
+              return out.str();
+            });
           }
         }
-        if (!isFinite(value)) {
-          finite = false;
-          ++f->stats.law_not_finite;
+      } catch (...) {
+        finite = false;
+        value = Vec3{};
+        ++f->stats.law_threw;
+        s.report(*f, DiagnosticKind::LawThrew, [&] {
           std::ostringstream out;
-          out << "law gave surface velocity (" << value.x << ", " << value.y << ", " << value.z
-              << ") at p = (" << p.x << ", " << p.y << ", " << p.z << "), t = " << s.time
-              << "; contact left undriven";
-          s.report(*f, DiagnosticKind::LawNotFinite, out.str());
-        }
+          out << "law threw at p = (" << p.x << ", " << p.y << ", " << p.z << "), t = " << s.time
+              << ": " << Impl::describeCurrent() << "; contact left undriven";
+          return out.str();
+        });
       }
       (f == f_first ? c_first : c_second) = value;
       if (f->changed) {  // the law changed: wake sleeping parts on it
@@ -368,14 +444,17 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
       surf.mode |= dContactApprox1;
     } else if ((surf.mode & dContactApprox1) == 0 &&
                !primary.reported[static_cast<int>(DiagnosticKind::ForceCapFriction)]) {
-      s.report(primary, DiagnosticKind::ForceCapFriction,
-               "contact without dContactApprox1: mu = " + std::to_string(surf.mu) +
-                   " is a force cap in newtons, not a coefficient");
+      s.report(primary, DiagnosticKind::ForceCapFriction, [&] {
+        return "contact without dContactApprox1: mu = " + std::to_string(surf.mu) +
+               " is a force cap in newtons, not a coefficient";
+      });
     }
     if (surf.mu == 0) {
       ++primary.stats.zero_friction;
-      s.report(primary, DiagnosticKind::ZeroFriction,
-               "contact mu = 0: ODE applies no friction, so the surface motion has no effect");
+      s.report(primary, DiagnosticKind::ZeroFriction, [] {
+        return std::string(
+            "contact mu = 0: ODE applies no friction, so the surface motion has no effect");
+      });
     }
 
     const Vec3 c_rel = tangentialPart(c_second - c_first, n);
@@ -420,6 +499,10 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
     ++kept;
   }
   return kept;
+}
+
+std::uint64_t FeederSet::invalidCalls() const {
+  return impl_->invalid_calls;
 }
 
 FeederStats FeederSet::stats(dGeomID geom) const {

@@ -35,6 +35,48 @@ void requireFinite(const std::string& where, const std::string& what, const Vec3
   requireFinite(where, what + ".z", v.z);
 }
 
+// Refuses |v| beyond `limit` (v finite; hypot does not overflow on the way).
+void requireNormWithin(const std::string& where, const std::string& what, const Vec3& v,
+                       double limit, const char* unit) {
+  const double length = std::hypot(v.x, v.y, v.z);
+  if (length <= limit) return;
+  std::ostringstream out;
+  out << where << ": |" << what << "| = " << length << " " << unit
+      << " is beyond the limit: must be in [0, " << limit << "] " << unit;
+  throw std::invalid_argument(out.str());
+}
+
+void requireComponentsWithin(const std::string& where, const std::string& what, const Vec3& v,
+                             double limit, const char* unit) {
+  const std::pair<const char*, double> parts[] = {{".x", v.x}, {".y", v.y}, {".z", v.z}};
+  for (const auto& [axis, value] : parts) {
+    if (std::fabs(value) <= limit) continue;
+    std::ostringstream out;
+    out << where << ": " << what << axis << " = " << value << " " << unit
+        << " is beyond the limit: must be in [" << -limit << ", " << limit << "] " << unit;
+    throw std::invalid_argument(out.str());
+  }
+}
+
+// The first value of a frozen twist beyond the limits (v, w world; o the origin), or empty.
+std::string firstBeyondLimits(const Vec3& v, const Vec3& w, const Vec3& o) {
+  std::ostringstream out;
+  const double speed = std::hypot(v.x, v.y, v.z), spin = std::hypot(w.x, w.y, w.z);
+  if (!(speed <= kMaxSurfaceSpeed)) {
+    out << "|twist.linear| = " << speed << " m/s is beyond the limit [0, " << kMaxSurfaceSpeed
+        << "] m/s";
+  } else if (!(spin <= kMaxAngularSpeed)) {
+    out << "|twist.angular| = " << spin << " rad/s is beyond the limit [0, " << kMaxAngularSpeed
+        << "] rad/s";
+  } else if (!(std::fmax(std::fabs(o.x), std::fmax(std::fabs(o.y), std::fabs(o.z))) <=
+               kMaxOriginCoordinate)) {
+    out << "twist.origin = (" << o.x << ", " << o.y << ", " << o.z
+        << ") m is beyond the limit: coordinates in [" << -kMaxOriginCoordinate << ", "
+        << kMaxOriginCoordinate << "] m";
+  }
+  return out.str();
+}
+
 // Names the first non-finite vector of `t` with its value ("twist.linear = (inf, 0, 0)"), or
 // returns empty.
 std::string firstNonFinite(const Twist& t) {
@@ -47,6 +89,17 @@ std::string firstNonFinite(const Twist& t) {
     return out.str();
   }
   return {};
+}
+
+// The message of the exception being handled (call inside a catch block only).
+std::string describe() {
+  try {
+    throw;
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (...) {
+    return "an exception that is not a std::exception";
+  }
 }
 
 }  // namespace
@@ -187,12 +240,29 @@ bool MotionLaw::isTimeVarying() const {
          (kind_ == Kind::Field && field_time_varying_);
 }
 
+double TimeProfile::largestConstantValue() const {
+  switch (kind_) {
+    case Kind::Constant:
+      return std::fabs(a_);
+    case Kind::Ramp:
+      return std::fmax(std::fabs(c_), std::fabs(d_));
+    case Kind::OnOff:
+      return 1.0;
+    case Kind::Function:
+      return 1.0;  // unknown here: checked each step
+  }
+  return 1.0;
+}
+
 void MotionLaw::validate(const std::string& where) const {
   switch (kind_) {
     case Kind::Twist:
       requireFinite(where, "twist.linear", twist_.linear);
       requireFinite(where, "twist.angular", twist_.angular);
       requireFinite(where, "twist.origin", twist_.origin);
+      requireNormWithin(where, "twist.linear", twist_.linear, kMaxSurfaceSpeed, "m/s");
+      requireNormWithin(where, "twist.angular", twist_.angular, kMaxAngularSpeed, "rad/s");
+      requireComponentsWithin(where, "twist.origin", twist_.origin, kMaxOriginCoordinate, "m");
       break;
     case Kind::Belt:
       requireFinite(where, "belt.direction", twist_.linear);
@@ -200,6 +270,12 @@ void MotionLaw::validate(const std::string& where) const {
         throw std::invalid_argument(where + ": belt.direction = (0, 0, 0) has no direction");
       }
       requireFinite(where, "belt.speed", belt_speed_);
+      if (!(std::fabs(belt_speed_) <= kMaxSurfaceSpeed)) {
+        std::ostringstream out;
+        out << "m/s is beyond the limit: must be in [" << -kMaxSurfaceSpeed << ", "
+            << kMaxSurfaceSpeed << "] m/s";
+        refuse(where, "belt.speed", belt_speed_, out.str());
+      }
       break;
     case Kind::Field:
       if (!field_) throw std::invalid_argument(where + ": field function is empty");
@@ -209,6 +285,28 @@ void MotionLaw::validate(const std::string& where) const {
       break;
   }
   profile_.validate(where);
+  // The profile scales every speed: the scaled constant law must stay within the limits too.
+  const double scale = profile_.largestConstantValue();
+  if (scale > 1.0 && (kind_ == Kind::Twist || kind_ == Kind::Belt)) {
+    const double speed = kind_ == Kind::Belt
+                             ? std::fabs(belt_speed_)
+                             : std::hypot(twist_.linear.x, twist_.linear.y, twist_.linear.z);
+    const double spin = kind_ == Kind::Belt
+                            ? 0.0
+                            : std::hypot(twist_.angular.x, twist_.angular.y, twist_.angular.z);
+    if (!(scale * speed <= kMaxSurfaceSpeed) || !(scale * spin <= kMaxAngularSpeed)) {
+      const bool linear = !(scale * speed <= kMaxSurfaceSpeed);
+      std::ostringstream out;
+      out << where << ": profile value " << scale << " times "
+          << (linear ? (kind_ == Kind::Belt ? "|belt.speed| = " : "|twist.linear| = ")
+                     : "|twist.angular| = ")
+          << (linear ? speed : spin) << (linear ? " m/s" : " rad/s") << " gives "
+          << scale * (linear ? speed : spin) << (linear ? " m/s" : " rad/s")
+          << ", beyond the limit: must be in [0, " << (linear ? kMaxSurfaceSpeed : kMaxAngularSpeed)
+          << (linear ? "] m/s" : "] rad/s");
+      throw std::invalid_argument(out.str());
+    }
+  }
 }
 
 StepLaw MotionLaw::evaluate(double t, const Pose* body_pose, double step) const {
@@ -221,7 +319,16 @@ StepLaw MotionLaw::evaluate(double t, const Pose* body_pose, double step) const 
     s.problem_ = out.str();
     return s;
   }
-  s.scale_ = profile_(t);
+  // A user function that throws gives a law that is not finite: evaluate runs inside ODE's
+  // near callback (through FeederSet::driveContacts), where no exception may pass.
+  try {
+    s.scale_ = profile_(t);
+  } catch (...) {
+    s.finite_ = false;
+    s.threw_ = true;
+    s.problem_ = "profile function threw at t = " + std::to_string(t) + ": " + describe();
+    return s;
+  }
   if (!std::isfinite(s.scale_)) {
     s.finite_ = false;
     s.problem_ = "profile(" + std::to_string(t) + ") = " + std::to_string(s.scale_);
@@ -234,8 +341,16 @@ StepLaw MotionLaw::evaluate(double t, const Pose* body_pose, double step) const 
     return s;
   }
 
-  Twist tw = kind_ == Kind::TwistFunction ? twist_function_(t) : twist_;
+  Twist tw = twist_;
   if (kind_ == Kind::TwistFunction) {
+    try {
+      tw = twist_function_(t);
+    } catch (...) {
+      s.finite_ = false;
+      s.threw_ = true;
+      s.problem_ = "twist function threw at t = " + std::to_string(t) + ": " + describe();
+      return s;
+    }
     const std::string bad = firstNonFinite(tw);
     if (!bad.empty()) {
       s.finite_ = false;
@@ -246,6 +361,15 @@ StepLaw MotionLaw::evaluate(double t, const Pose* body_pose, double step) const 
   const bool body = frame_ == Frame::Body && body_pose != nullptr;
   if (kind_ == Kind::Belt) {
     const double speed = s.scale_ * belt_speed_;
+    if (!(std::fabs(speed) <= kMaxSurfaceSpeed)) {
+      std::ostringstream out;
+      out << "profile(" << t << ") = " << s.scale_ << " times belt.speed = " << belt_speed_
+          << " m/s gives " << speed << " m/s, beyond the limit [" << -kMaxSurfaceSpeed << ", "
+          << kMaxSurfaceSpeed << "] m/s";
+      s.finite_ = false;
+      s.problem_ = out.str();
+      return s;
+    }
     s.eval_ = speed == 0.0 ? StepLaw::Eval::Zero : StepLaw::Eval::Belt;
     s.v_ = body ? body_pose->rotate(tw.linear) : tw.linear;
     s.w_.x = speed;
@@ -256,6 +380,17 @@ StepLaw MotionLaw::evaluate(double t, const Pose* body_pose, double step) const 
   s.v_ = body ? body_pose->rotate(v) : v;
   s.w_ = body ? body_pose->rotate(w) : w;
   s.o_ = body ? body_pose->transform(tw.origin) : tw.origin;
+  const std::string beyond = firstBeyondLimits(s.v_, s.w_, s.o_);
+  if (!beyond.empty()) {
+    std::ostringstream out;
+    out << (kind_ == Kind::TwistFunction ? "twist function" : "twist") << " at t = " << t;
+    if (s.scale_ != 1.0) out << " times profile " << s.scale_;
+    out << ": " << beyond;
+    s.finite_ = false;
+    s.problem_ = out.str();
+    s.eval_ = StepLaw::Eval::Zero;
+    return s;
+  }
   if (isZero(w)) {
     s.eval_ = isZero(v) ? StepLaw::Eval::Zero : StepLaw::Eval::Translation;
   } else if (step > 0.0) {

@@ -479,4 +479,263 @@ TEST(InfiniteFriction, DInfinityMuWithForcedApprox1StaysFiniteAndSticksAtOnce) {
   EXPECT_NEAR(linearVelocity(part).x, 0.3, 1e-9);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Speeds beyond what ODE can take (motion_law.hpp, Limits): refused where the law is made, or
+// (user functions, long lever arms) left undriven at the contact
+
+namespace {
+
+// Speeds near sqrt(DBL_MAX) = 1.3e154 overflow |c|^2: before the limits, such a belt gave
+// motion1 = inf and fdir1 = 0 with no word.
+constexpr double kOverflowingSpeed = 1e154;
+
+// A belt, field or twist contact as in a real step: drives `c` through `set`.
+void driveOne(FeederSet& set, dContact& c) {
+  set.beginStep(0.0, 0.01);
+  ASSERT_EQ(set.driveContacts(&c, 1), 1);
+}
+
+// The contact imposes no surface motion (and ODE gets no non-finite or huge number).
+void expectUndriven(const dContact& c) {
+  EXPECT_FALSE(c.surface.mode & (dContactMotion1 | dContactFDir1 | dContactMotion2));
+  EXPECT_EQ(c.surface.motion1, 0.0);
+}
+
+}  // namespace
+
+TEST_F(BadInput, BeltSpeedBeyondTheLimitIsRefusedWithValueAndRange) {
+  for (double speed : {kOverflowingSpeed, -kOverflowingSpeed, 1.01 * kMaxSurfaceSpeed, 1e300}) {
+    SCOPED_TRACE(speed);
+    expectMentions(refusal([&] {
+                     set_.add(static_geom_, MotionLaw::belt({1, 0, 0}, speed));
+                   }),
+                   {"FeederSet::add", "feeder geom", "belt.speed = ", "m/s", "[-1e+100, 1e+100]"});
+  }
+  EXPECT_EQ(set_.size(), 0);
+  set_.add(static_geom_, MotionLaw::belt({1, 0, 0}, kMaxSurfaceSpeed));  // the limit itself
+  dContact c = contact(static_geom_, part_);
+  driveOne(set_, c);
+  EXPECT_EQ(c.surface.motion1, kMaxSurfaceSpeed);
+  // ODE makes the part node0 (the static feeder has no body): (v_part - 0) . fdir1 = motion1.
+  EXPECT_EQ(c.fdir1[0], 1.0);
+  // A slanted belt at the limit is driven too, whatever the rounding of its projection.
+  set_.setLaw(static_geom_, MotionLaw::belt({1, 1, 0.3}, kMaxSurfaceSpeed));
+  c = contact(static_geom_, part_);
+  driveOne(set_, c);
+  EXPECT_TRUE(c.surface.mode & dContactMotion1);
+  // The belt's normalisation, projection and renormalisation: a few roundings of 2.2e-16.
+  constexpr double kFewRoundings = 8 * std::numeric_limits<double>::epsilon();
+  EXPECT_NEAR(c.surface.motion1 / kMaxSurfaceSpeed, 1.0, kFewRoundings);
+  EXPECT_EQ(set_.stats(static_geom_).law_not_finite, 0u);
+}
+
+TEST_F(BadInput, TranslationSpeedBeyondTheLimitIsRefusedByItsLength) {
+  // Components each within the limit, length beyond it: 8e99 * sqrt(2) = 1.13e100 m/s.
+  for (const Vec3& v : {Vec3{kOverflowingSpeed, 0, 0}, Vec3{0, 0, -1e200}, Vec3{8e99, 8e99, 0}}) {
+    SCOPED_TRACE(v.x + v.y + v.z);
+    expectMentions(refusal([&] { set_.add(static_geom_, MotionLaw::translation(v)); }),
+                   {"|twist.linear| = ", "m/s", "[0, 1e+100] m/s"});
+  }
+  EXPECT_EQ(set_.size(), 0);
+}
+
+TEST_F(BadInput, AngularSpeedBeyondTheLimitIsRefused) {
+  expectMentions(refusal([&] {
+                   set_.add(static_geom_, MotionLaw::rotation({0, 0, kOverflowingSpeed}, {}));
+                 }),
+                 {"|twist.angular| = 1e+154 rad/s", "[0, 1e+100] rad/s"});
+  expectMentions(refusal([&] {
+                   set_.add(body_geom_, MotionLaw::twist({{}, {-1e101, 0, 0}, {}}, Frame::Body));
+                 }),
+                 {"|twist.angular| = 1e+101 rad/s"});
+  EXPECT_EQ(set_.size(), 0);
+}
+
+TEST_F(BadInput, TwistOriginBeyondTheLimitIsRefused) {
+  expectMentions(refusal([&] {
+                   set_.add(static_geom_, MotionLaw::rotation({0, 0, 1}, {0, -1e120, 0}));
+                 }),
+                 {"twist.origin.y = -1e+120 m", "[-1e+100, 1e+100] m"});
+}
+
+TEST_F(BadInput, ProfileThatScalesASpeedBeyondTheLimitIsRefused) {
+  // Each factor is fine alone; their product is not.
+  expectMentions(
+      refusal([&] {
+        set_.add(static_geom_,
+                 MotionLaw::belt({1, 0, 0}, 1e60).withProfile(TimeProfile::constant(1e60)));
+      }),
+      {"profile value 1e+60", "|belt.speed| = 1e+60", "gives 1e+120 m/s", "[0, 1e+100] m/s"});
+  expectMentions(
+      refusal([&] {
+        set_.add(
+            static_geom_,
+            MotionLaw::rotation({0, 0, 1e50}, {}).withProfile(TimeProfile::ramp(0, 1, 0, -1e60)));
+      }),
+      {"profile value 1e+60", "|twist.angular| = 1e+50", "rad/s", "1e+100"});
+  set_.add(
+      static_geom_,
+      MotionLaw::belt({1, 0, 0}, 2.0).withProfile(TimeProfile::constant(5e99)));  // 1e100 exactly
+}
+
+TEST_F(BadInput, SetLawWithASpeedBeyondTheLimitKeepsTheOldLaw) {
+  set_.add(static_geom_, MotionLaw::belt({1, 0, 0}, 0.3));
+  expectMentions(refusal([&] {
+                   set_.setLaw(static_geom_, MotionLaw::belt({1, 0, 0}, kOverflowingSpeed));
+                 }),
+                 {"FeederSet::setLaw", "belt.speed = 1e+154"});
+  dContact c = contact(static_geom_, part_);
+  driveOne(set_, c);
+  EXPECT_DOUBLE_EQ(c.surface.motion1, 0.3);
+}
+
+TEST_F(BadInput, FieldValueBeyondTheLimitLeavesTheContactUndriven) {
+  // Finite but overflowing: |c|^2 = inf. Before the per-contact guard: motion1 = inf, fdir1 = 0.
+  set_.add(static_geom_, MotionLaw::field([](const Vec3&, const Vec3&, double) {
+             return Vec3{kOverflowingSpeed, kOverflowingSpeed, 0};
+           }));
+  dContact c = contact(static_geom_, part_);
+  driveOne(set_, c);
+  expectUndriven(c);
+  EXPECT_EQ(set_.stats(static_geom_).law_not_finite, 1u);
+  EXPECT_EQ(set_.stats(static_geom_).contacts_undriven, 1);
+  ASSERT_NE(last(DiagnosticKind::LawNotFinite), nullptr);
+  expectMentions(last(DiagnosticKind::LawNotFinite)->message,
+                 {"(1e+154, 1e+154, 0) m/s", "1e+100 m/s", "undriven"});
+}
+
+TEST_F(BadInput, LongLeverArmBeyondTheLimitLeavesTheContactUndriven) {
+  // |w| at the limit is accepted; 10 m from the axis w x r is 1e101 m/s, beyond the limit.
+  set_.add(static_geom_, MotionLaw::rotation({0, 0, kMaxAngularSpeed}, {-10, 0, 0}));
+  dContact c = contact(static_geom_, part_);
+  set_.beginStep(0.0);  // the instantaneous field w x (p - O)
+  ASSERT_EQ(set_.driveContacts(&c, 1), 1);
+  expectUndriven(c);
+  EXPECT_EQ(set_.stats(static_geom_).law_not_finite, 1u);
+  expectMentions(last(DiagnosticKind::LawNotFinite)->message, {"1e+101", "1e+100 m/s"});
+}
+
+TEST_F(BadInput, TwistFunctionBeyondTheLimitLeavesTheContactUndriven) {
+  set_.add(static_geom_, MotionLaw::twistFunction([](double) {
+             return Twist{{0, 2e100, 0}, {}, {}};
+           }));
+  dContact c = contact(static_geom_, part_);
+  driveOne(set_, c);
+  expectUndriven(c);
+  EXPECT_EQ(set_.stats(static_geom_).law_not_finite, 1u);
+  expectMentions(last(DiagnosticKind::LawNotFinite)->message,
+                 {"twist function at t = 0", "|twist.linear| = 2e+100 m/s", "[0, 1e+100] m/s"});
+}
+
+TEST_F(BadInput, FunctionProfileBeyondTheLimitLeavesTheContactUndriven) {
+  set_.add(static_geom_,
+           MotionLaw::belt({1, 0, 0}, 2.0).withProfile(TimeProfile::function([](double) {
+             return 1e100;
+           })));
+  dContact c = contact(static_geom_, part_);
+  driveOne(set_, c);
+  expectUndriven(c);
+  EXPECT_EQ(set_.stats(static_geom_).law_not_finite, 1u);
+  expectMentions(last(DiagnosticKind::LawNotFinite)->message,
+                 {"profile(0) = 1e+100", "belt.speed = 2 m/s", "gives 2e+100 m/s"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// User functions that throw inside driveContacts (noexcept, called from ODE's near callback):
+// the contact is left undriven and counted, never std::terminate
+
+TEST_F(BadInput, ThrowingFieldLeavesTheContactUndrivenAndIsCounted) {
+  set_.add(static_geom_, MotionLaw::field([](const Vec3&, const Vec3&, double) -> Vec3 {
+             throw std::runtime_error("field boom");
+           }));
+  dContact c[2] = {contact(static_geom_, part_), contact(static_geom_, part_)};
+  set_.beginStep(0.0);
+  ASSERT_EQ(set_.driveContacts(c, 2), 2);  // kept (the normal row is still needed)
+  expectUndriven(c[0]);
+  expectUndriven(c[1]);
+  EXPECT_EQ(set_.stats(static_geom_).law_threw, 2u);
+  EXPECT_EQ(set_.stats(static_geom_).law_not_finite, 0u);
+  EXPECT_EQ(count(DiagnosticKind::LawThrew), 2);
+  expectMentions(last(DiagnosticKind::LawThrew)->message, {"field boom", "undriven"});
+  EXPECT_STREQ(toString(DiagnosticKind::LawThrew), "law_threw");
+}
+
+TEST_F(BadInput, ThrowingTwistFunctionLeavesTheContactUndriven) {
+  set_.add(static_geom_, MotionLaw::twistFunction([](double) -> Twist {
+             throw std::out_of_range("no twist at this time");
+           }));
+  dContact c = contact(static_geom_, part_);
+  driveOne(set_, c);
+  expectUndriven(c);
+  EXPECT_EQ(set_.stats(static_geom_).law_threw, 1u);
+  expectMentions(last(DiagnosticKind::LawThrew)->message,
+                 {"twist function threw", "no twist at this time"});
+}
+
+TEST_F(BadInput, ProfileThrowingANonStandardExceptionLeavesTheContactUndriven) {
+  set_.add(static_geom_,
+           MotionLaw::belt({1, 0, 0}, 0.3).withProfile(TimeProfile::function([](double) -> double {
+             throw 42;
+           })));
+  dContact c = contact(static_geom_, part_);
+  driveOne(set_, c);
+  expectUndriven(c);
+  EXPECT_EQ(set_.stats(static_geom_).law_threw, 1u);
+  expectMentions(last(DiagnosticKind::LawThrew)->message,
+                 {"profile function threw", "not a std::exception"});
+}
+
+TEST_F(BadInput, ThrowingFieldAgainstAGoodFeederIsCountedOnTheThrowingOne) {
+  set_.add(static_geom_, MotionLaw::belt({1, 0, 0}, 0.3));
+  set_.add(body_geom_, MotionLaw::field([](const Vec3&, const Vec3&, double) -> Vec3 {
+             throw std::runtime_error("boom");
+           }));
+  dContact c = contact(static_geom_, body_geom_);
+  driveOne(set_, c);
+  expectUndriven(c);
+  EXPECT_EQ(set_.stats(body_geom_).law_threw, 1u);
+  EXPECT_EQ(set_.stats(static_geom_).law_threw, 0u);
+  EXPECT_EQ(last(DiagnosticKind::LawThrew)->feeder, body_geom_);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Caller bugs in driveContacts: nothing driven, 0 returned, reported
+
+TEST_F(BadInput, NullContactArrayWithAPositiveCountReturnsZeroAndIsReported) {
+  set_.add(static_geom_, MotionLaw::belt({1, 0, 0}, 0.3));
+  set_.beginStep(0.0);
+  EXPECT_EQ(set_.driveContacts(nullptr, 3), 0);  // was 3: joints made from a null array
+  EXPECT_EQ(set_.invalidCalls(), 1u);
+  ASSERT_EQ(count(DiagnosticKind::InvalidCall), 1);
+  const Diagnostic& d = *last(DiagnosticKind::InvalidCall);
+  EXPECT_EQ(d.feeder, nullptr);
+  expectMentions(d.message, {"driveContacts", "null", "count = 3", "0 returned"});
+  EXPECT_EQ(set_.driveContacts(nullptr, 0), 0);  // nothing to drive: not a bug
+  EXPECT_EQ(set_.invalidCalls(), 1u);
+  EXPECT_STREQ(toString(DiagnosticKind::InvalidCall), "invalid_call");
+}
+
+TEST_F(BadInput, NegativeCountReturnsZeroAndIsReportedWithAndWithoutFeeders) {
+  dContact c = contact(static_geom_, part_);
+  EXPECT_EQ(set_.driveContacts(&c, -1), 0);  // no feeder registered yet
+  set_.add(static_geom_, MotionLaw::belt({1, 0, 0}, 0.3));
+  set_.beginStep(0.0);
+  EXPECT_EQ(set_.driveContacts(&c, -7), 0);
+  EXPECT_EQ(set_.invalidCalls(), 2u);
+  expectMentions(last(DiagnosticKind::InvalidCall)->message,
+                 {"count = -7", "negative", "[0, number of contacts]"});
+  EXPECT_FALSE(c.surface.mode & dContactMotion1);  // untouched
+}
+
+TEST(BadInputDefaultHandler, InvalidCallIsPrintedOnceOnStderrAndCountedAlways) {
+  FeederSet set;
+  testing::internal::CaptureStderr();
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(set.driveContacts(nullptr, 2), 0);
+  const std::string printed = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(set.invalidCalls(), 3u);
+  expectMentions(printed, {"rheofeed [invalid_call]", "count = 2", "invalidCalls"});
+  EXPECT_EQ(printed.find("rheofeed [invalid_call]"), printed.rfind("rheofeed [invalid_call]"))
+      << "printed more than once: " << printed;
+}
+
 }  // namespace rheofeed::test

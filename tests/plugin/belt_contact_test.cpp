@@ -52,7 +52,7 @@ struct FlatBelt {
 /// A static belt inclined by `theta` (rad) so that its surface rises along +x, with a cubic
 /// part resting on it (same orientation). The incline's unit direction is (cos, 0, sin).
 struct InclinedBelt {
-  InclinedBelt(double theta, double speed) : theta(theta) {
+  InclinedBelt(double incline, double speed) : theta(incline) {
     w.setSurface(dContactApprox1, kMu);
     dWorldSetContactSurfaceLayer(w.world, kLayer);
     // Turning by -theta about +y maps x to (cos, 0, sin) and z to the normal (-sin, 0, cos).

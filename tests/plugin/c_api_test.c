@@ -6,6 +6,7 @@
  */
 #include <math.h>
 #include <ode/ode.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -41,6 +42,17 @@ static int failures = 0;
       ++failures;                                                                            \
     }                                                                                        \
   } while (0)
+
+/* ODE's own messages are failures here too (as ode_message_guard.hpp makes them in the C++
+ * tests): counted and printed; for errors and debug messages ODE ends the process after this
+ * returns (exit(1) or abort()), so the message is printed first. */
+static void odeMessage(int number, const char* format, va_list args) {
+  fprintf(stderr, "c_api_test: ODE message %d: ", number);
+  vfprintf(stderr, format, args);
+  fprintf(stderr, "\n");
+  fflush(stderr);
+  ++failures;
+}
 
 /* fdir1 is c / |c| in double precision: unit and orthogonal to the normal up to round-off. */
 #define ROUND_OFF 1e-14
@@ -86,6 +98,9 @@ int main(void) {
   struct Seen seen;
 
   dInitODE2(0);
+  dSetErrorHandler(odeMessage);
+  dSetDebugHandler(odeMessage);
+  dSetMessageHandler(odeMessage);
   world = dWorldCreate();
   dWorldSetGravity(world, 0, 0, -9.81);
   joints = dJointGroupCreate(0);
@@ -282,7 +297,35 @@ int main(void) {
   CHECK(seen.count == 1);
   CHECK(strcmp(seen.kind, "invalid_contact") == 0);
   CHECK_MENTIONS(seen.message, "mu = -1");
+
+  /* A null array with a positive count, or a negative count, is a caller bug: an error code
+   * (never the count), a message naming the value, an "invalid_call" diagnostic. */
+  memset(&seen, 0, sizeof seen);
+  CHECK(rfFeederSetDriveContacts(set, 0, 3) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "null");
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "count = 3");
+  CHECK(seen.count == 1);
+  CHECK(strcmp(seen.kind, "invalid_call") == 0);
+  CHECK(rfFeederSetDriveContacts(set, contacts, -2) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "count = -2");
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "negative");
+  CHECK(seen.count == 2);
+  CHECK(rfFeederSetDriveContacts(set, 0, 0) == 0); /* nothing to drive: fine */
+  CHECK(strcmp(rfFeederSetGetLastError(set), "") == 0);
+  CHECK(seen.count == 2);
   rfFeederSetSetDiagnosticFunction(set, 0, 0);
+
+  /* Speeds beyond the limit (1e100 m/s: ODE squares them) are refused with the value. */
+  {
+    const double huge[3] = {1e154, 0, 0};
+    CHECK(rfFeederSetSetBelt(set, belt, x_axis, 1e154, rfFrameWorld) == rfErrorInvalidArgument);
+    CHECK_MENTIONS(rfFeederSetGetLastError(set), "belt.speed = 1e+154");
+    CHECK_MENTIONS(rfFeederSetGetLastError(set), "1e+100");
+    CHECK(rfFeederSetSetTwist(set, belt, huge, zero, zero, rfFrameWorld) == rfErrorInvalidArgument);
+    CHECK_MENTIONS(rfFeederSetGetLastError(set), "|twist.linear| = 1e+154");
+    CHECK(rfFeederSetSetTwist(set, belt, zero, huge, zero, rfFrameWorld) == rfErrorInvalidArgument);
+    CHECK_MENTIONS(rfFeederSetGetLastError(set), "|twist.angular| = 1e+154 rad/s");
+  }
 
   /* Remove, then it is unknown. */
   CHECK(rfFeederSetRemove(set, belt) == rfOK);

@@ -314,9 +314,14 @@ TEST_F(HandMadeContacts, NoFeedersMeansNoChangeAtAll) {
   set.beginStep(0.0);
   EXPECT_EQ(set.driveContacts(&c, 1), 1);
   EXPECT_EQ(std::memcmp(&c, &before, sizeof c), 0);
-  EXPECT_EQ(set.driveContacts(nullptr, 3), 3);
   EXPECT_EQ(set.driveContacts(&c, 0), 0);
+  // Caller bugs drive nothing and create no joint, with or without feeders (bad_input_test).
+  std::vector<Diagnostic> seen;
+  set.setDiagnosticHandler([&seen](const Diagnostic& d) { seen.push_back(d); });
+  EXPECT_EQ(set.driveContacts(nullptr, 3), 0);
   EXPECT_EQ(set.driveContacts(&c, -2), 0);
+  EXPECT_EQ(set.invalidCalls(), 2u);
+  EXPECT_EQ(seen.size(), 2u);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -35,8 +35,8 @@ constexpr double kHeavyMass = 1e4;  // kg, against a 1 kg part
 /// A feeder with a twist law (translation plus a turn about a point off the part, so the part
 /// moves in x and y and spins) and a part released on it; stepped with a forced geom order.
 struct LayoutRun {
-  LayoutRun(Carrier carrier, bool feeder_g1, AttachOrder order)
-      : w(options(order)), carrier(carrier), feeder_g1(feeder_g1) {
+  LayoutRun(Carrier carrier_kind, bool g1_is_feeder, AttachOrder order)
+      : w(options(order)), carrier(carrier_kind), feeder_g1(g1_is_feeder) {
     dWorldSetContactSurfaceLayer(w.world, kLayer);
     feeder = dCreateBox(w.space, 2.0, 1.0, 0.1);
     if (carrier == Carrier::Static) {

@@ -30,7 +30,7 @@ constexpr double kPartMass = 0.1;   // kg
 // Approx1 pyramid, fdir1 along c_t = w x r puts the radial force on the second friction row,
 // bounded by mu N as well). Short runs keep the parts near their start radius.
 struct Turntable {
-  explicit Turntable(double w) : w(w) {
+  explicit Turntable(double angular_speed) : w(angular_speed) {
     world.setSurface(dContactApprox1, kTableMu);
     dWorldSetContactSurfaceLayer(world.world, kLayer);
     table = world.staticBox(1.2, 1.2, 0.1, 0, 0, -0.05);
@@ -256,7 +256,7 @@ constexpr double kHelixW = 1.0;  // rad/s
 /// feeder with the rotation law w about z. pitch > 0: right-handed, rising counter-clockwise
 /// seen from above. A small box part starts on the track at phi = 0.
 struct HelixRamp {
-  HelixRamp(double pitch, double w) : pitch(pitch) {
+  HelixRamp(double rise_per_turn, double w) : pitch(rise_per_turn) {
     world.setSurface(dContactApprox1, kHelixMu);
     dWorldSetContactSurfaceLayer(world.world, kLayer);
     slope = std::atan(pitch / (2 * kPi * kHelixRadius));  // signed slope along +phi

@@ -2,6 +2,8 @@
 // Test fixture: a small ODE world (gravity -z) stepped with a FeederSet and ContactCollider,
 // plus the few vector helpers the tests use to compute their expectations. Expected values are
 // computed by the tests themselves with these helpers (plain formulas), never by the plugin.
+// Including this header puts every test of the binary under an OdeMessageGuard
+// (ode_message_guard.hpp): any ODE error, debug or warning message fails the test.
 #pragma once
 
 #include <ode/ode.h>
@@ -12,6 +14,7 @@
 #include <memory>
 #include <utility>
 
+#include "ode_message_guard.hpp"
 #include "rheofeed/contact_collider.hpp"
 #include "rheofeed/feeder_set.hpp"
 

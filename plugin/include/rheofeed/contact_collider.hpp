@@ -16,12 +16,23 @@
 ///     dWorldQuickStep(world, h);
 ///
 /// Applications that call dSpaceCollide themselves pass `&collider` and
-/// `ContactCollider::nearCallback` to it (after `beginStep(time, h)` and `clearJoints()`).
+/// `ContactCollider::nearCallback` to it (after `beginStep(time, h)` and `clearJoints()`), and
+/// call `rethrowPendingError()` after dSpaceCollide returns.
+///
+/// ## Exceptions
+/// No exception crosses ODE: the near callback catches everything thrown inside it (by the
+/// SurfaceCallback, by an allocation for the joint list), keeps the first exception, and does
+/// no more work for the rest of the pass (every later pair is skipped). collide() then empties
+/// the joint group and the FeederSet's records (a world stepped anyway has no contact joints
+/// from the failed pass, and no record points at a destroyed joint) and rethrows that
+/// exception after dSpaceCollide has returned. The collider and the world stay usable: the next
+/// collide() starts afresh.
 #pragma once
 
 #include <ode/ode.h>
 
 #include <deque>
+#include <exception>
 #include <functional>
 #include <vector>
 
@@ -31,7 +42,8 @@ namespace rheofeed {
 
 /// Fills `contacts[0..count)` (produced by dCollide for geoms o1, o2) with the application's
 /// surface parameters (mode, mu, bounce, soft_erp, ...). Return false to reject the pair. Called
-/// from inside dSpaceCollide; it must not throw.
+/// from inside dSpaceCollide. If it throws, the exception is kept and rethrown by
+/// ContactCollider::collide after dSpaceCollide returns (file comment), never through ODE.
 using SurfaceCallback = std::function<bool(dGeomID o1, dGeomID o2, dContact* contacts, int count)>;
 
 /// Collides a space and creates the step's contact joints. Owns its contact joint group.
@@ -66,12 +78,23 @@ class ContactCollider {
   /// world is then stepped with, see FeederSet::beginStep; 0 gives rotating laws'
   /// instantaneous field): empties the joint group, calls feeders.beginStep(time, step),
   /// collides `space` (recursing into sub-spaces) and creates joints. Throws
-  /// std::invalid_argument (from beginStep) for a non-finite time or a bad step.
+  /// std::invalid_argument (from beginStep) for a non-finite time or a bad step. Rethrows the
+  /// first exception thrown inside the pass (by the SurfaceCallback or an allocation) after
+  /// dSpaceCollide has returned, with the joint group and the feeders' records emptied (file
+  /// comment). An error left pending by a manual dSpaceCollide pass is rethrown first, before
+  /// anything is done.
   void collide(dSpaceID space, double time, double step = 0.0);
-  /// Empties the contact joint group (collide does it).
+  /// Empties the contact joint group (collide does it). Does not clear a pending error.
   void clearJoints();
-  /// A dNearCallback; `data` must be a ContactCollider*.
+  /// A dNearCallback; `data` must be a ContactCollider*. Never throws: an exception inside is
+  /// kept (the first one) and the rest of the pass is skipped; see rethrowPendingError.
   static void nearCallback(void* data, dGeomID o1, dGeomID o2);
+  /// Whether a near callback caught an exception that is not rethrown yet.
+  bool hasPendingError() const { return static_cast<bool>(error_); }
+  /// Rethrows (and clears) the first exception caught by nearCallback since the last call;
+  /// does nothing if there is none. Applications that call dSpaceCollide with nearCallback
+  /// themselves call it after dSpaceCollide returns (until then every pair is skipped).
+  void rethrowPendingError();
 
   /// A contact joint created since the last clearJoints.
   struct Joint {
@@ -98,6 +121,7 @@ class ContactCollider {
   std::deque<dJointFeedback> feedback_;
   std::size_t feedback_used_ = 0;
   std::vector<Joint> joints_;
+  std::exception_ptr error_;  // first exception caught in the near callback, not yet rethrown
 };
 
 }  // namespace rheofeed

@@ -44,10 +44,13 @@
 /// feeder on a kinematic or dynamic body, feeder as g1 or as g2, and feeder against feeder.
 ///
 /// ## Bad input
-/// Registration errors throw std::invalid_argument with a message naming the value. Inside
-/// driveContacts (called from an ODE callback) nothing throws: a bad contact is reported through
-/// the diagnostic handler, counted in FeederStats, and either removed from the array (bad data
-/// ODE would abort on) or left undriven (a law that returned a non-finite value).
+/// Registration errors throw std::invalid_argument with a message naming the value and the
+/// allowed range (speed limits: motion_law.hpp). Inside driveContacts (called from an ODE
+/// callback) nothing throws: a bad contact is reported through the diagnostic handler, counted
+/// in FeederStats, and either removed from the array (bad data ODE would abort on) or left
+/// undriven (a law that gave a non-finite value or one beyond kMaxSurfaceSpeed, or a user
+/// function - field, twist function, profile - that threw). A bad call (a null array with a
+/// positive count, a negative count) drives nothing, returns 0 and is reported (InvalidCall).
 #pragma once
 
 #include <ode/ode.h>
@@ -77,8 +80,12 @@ enum class AttachOrder {
 enum class DiagnosticKind {
   InvalidContact,    ///< non-finite position/normal/depth, or mu NaN or negative: contact removed
   ZeroFriction,      ///< mu = 0 on a feeder contact: ODE ignores motion1 then (contact kept)
-  LawNotFinite,      ///< the law (profile, twist function or field) gave a non-finite value
+  LawNotFinite,      ///< the law (profile, twist function or field) gave a non-finite value,
+                     ///< or one beyond the limits of motion_law.hpp: contact left undriven
   ForceCapFriction,  ///< the contact opted out of dContactApprox1: mu is a force cap (N)
+  LawThrew,          ///< a field, twist function or profile threw: contact left undriven
+  InvalidCall,       ///< driveContacts called with a null array and count > 0, or count < 0
+                     ///< (Diagnostic::feeder is null): nothing driven, 0 returned
 };
 /// Printable name of a DiagnosticKind ("invalid_contact", ...).
 const char* toString(DiagnosticKind kind);
@@ -86,7 +93,7 @@ const char* toString(DiagnosticKind kind);
 /// One report from the plugin; `message` names the value and the feeder geom.
 struct Diagnostic {
   DiagnosticKind kind;
-  dGeomID feeder;       ///< the feeder geom involved
+  dGeomID feeder;       ///< the feeder geom involved (null for InvalidCall)
   std::string message;  ///< e.g. "feeder geom 0x55..: contact mu = -0.2 is negative; ..."
 };
 
@@ -97,8 +104,10 @@ struct FeederStats {
   int contacts_undriven = 0;           ///< feeder contacts left with c = 0 (tiny c_rel or bad law)
   std::uint64_t invalid_contacts = 0;  ///< contacts removed for bad data (all steps)
   std::uint64_t zero_friction = 0;     ///< contacts with mu = 0 (all steps)
-  std::uint64_t law_not_finite = 0;    ///< contacts left undriven by a non-finite law (all steps)
-  std::uint64_t bodies_woken = 0;      ///< disabled parts woken by a law change (all steps)
+  /// contacts left undriven by a law value that was not finite or beyond the limits (all steps)
+  std::uint64_t law_not_finite = 0;
+  std::uint64_t law_threw = 0;     ///< contacts left undriven by a throwing law (all steps)
+  std::uint64_t bodies_woken = 0;  ///< disabled parts woken by a law change (all steps)
 };
 
 /// A driven contact as seen in the last collision pass (recorded on request).
@@ -171,8 +180,13 @@ class FeederSet {
   /// Drive the feeder contacts among `contacts[0..count)` (each dContact's geom.g1/g2 tell its
   /// geoms). Contacts that touch no feeder are left exactly as they were. Returns the number of
   /// contacts to create joints for: contacts with invalid data on a feeder are removed and the
-  /// rest moved forward in order. Never throws.
+  /// rest moved forward in order. Never throws (user functions that throw leave their contact
+  /// undriven: DiagnosticKind::LawThrew). A null `contacts` with count > 0, or count < 0, is a
+  /// caller bug: nothing is read or driven, 0 is returned (no joint to create) and it is
+  /// reported as DiagnosticKind::InvalidCall and counted (invalidCalls).
   int driveContacts(dContact* contacts, int count) noexcept;
+  /// Number of driveContacts calls refused as InvalidCall since construction.
+  std::uint64_t invalidCalls() const;
 
   /// Counters of one feeder (throws if unregistered).
   FeederStats stats(dGeomID geom) const;

@@ -53,6 +53,27 @@
 
 namespace rheofeed {
 
+/// ## Limits (MotionLaw::validate, MotionLaw::evaluate, FeederSet::driveContacts)
+/// ODE receives the relative surface velocity c_rel as `motion1 = |c_rel|` and `fdir1 =
+/// c_rel / |c_rel|`. |c_rel| is a sum of squares, and a double overflows at 1.8e308 = (1.3e154)^2:
+/// speeds near 1e154 m/s gave motion1 = inf and fdir1 = 0 with no word. ODE's step then divides
+/// motion1 by h and multiplies it by masses and Jacobian entries, and squares body speeds (the
+/// auto-disable test). The limits below keep every such square at most 1e200, leaving a factor
+/// 1e108 for those products; they are far beyond any feeder (the speed of light is 3e8 m/s), so
+/// they only refuse numbers that cannot be simulated. A law is checked against them where it
+/// is made (validate: constant speeds times the largest constant or ramp profile value), when
+/// it is frozen for a step (twist functions and function profiles), and at every contact (a
+/// field's value, and w x (p - O) over a long lever arm): a contact whose c_t is not finite or
+/// is beyond kMaxSurfaceSpeed is left undriven, reported and counted (FeederStats).
+
+/// Largest surface speed |v|, |belt speed| and |c_t| at a contact (unit: m/s).
+constexpr double kMaxSurfaceSpeed = 1e100;
+/// Largest angular speed |w| of a twist (unit: rad/s).
+constexpr double kMaxAngularSpeed = 1e100;
+/// Largest |coordinate| of a twist's origin (unit: m); with |w| <= kMaxAngularSpeed the product
+/// w x (p - O) stays finite (<= ~1e200) and is then checked against kMaxSurfaceSpeed.
+constexpr double kMaxOriginCoordinate = 1e100;
+
 /// The frame a law's vectors are given in.
 enum class Frame {
   World,  ///< World frame; the law does not move.
@@ -71,7 +92,9 @@ struct Twist {
 /// A direct tangential field, for when the speed map is known: given the contact point `p`
 /// (m, world), the unit contact normal `n` (world) and the simulation time `t` (s), return the
 /// surface velocity (m/s, world). Any normal component of the result is discarded. It must be
-/// safe to call from the near callback, and must not throw.
+/// safe to call from the near callback. It should not throw; if it does (or returns a value that
+/// is not finite or beyond kMaxSurfaceSpeed), FeederSet::driveContacts leaves the contact
+/// undriven, reports and counts it; the exception never reaches ODE.
 using SurfaceField = std::function<Vec3(const Vec3& p, const Vec3& n, double t)>;
 
 /// A dimensionless scale `s(t)` applied to every velocity of a law (time `t` in seconds).
@@ -95,6 +118,9 @@ class TimeProfile {
   bool isConstant() const { return kind_ == Kind::Constant; }
   /// Throws std::invalid_argument naming the bad parameter (prefix names where it came from).
   void validate(const std::string& where) const;
+  /// The largest |s(t)| known without calling a user function: |scale|, max(|from|, |to|) of a
+  /// ramp, 1 for on/off and for a function profile (checked at every step instead).
+  double largestConstantValue() const;
 
  private:
   enum class Kind { Constant, Ramp, OnOff, Function };
@@ -156,17 +182,23 @@ class MotionLaw {
   /// field). Constant laws are evaluated once and cached.
   bool isTimeVarying() const;
 
-  /// Throws std::invalid_argument with a message naming the bad value and `where` it came from,
-  /// e.g. "feeder 0x55d0: law twist.linear.x = nan is not finite".
+  /// Throws std::invalid_argument with a message naming the bad value, `where` it came from and
+  /// the allowed range, e.g. "feeder 0x55d0: twist.linear.x = nan is not finite" or
+  /// "...: |twist.angular| = 1e+200 rad/s is beyond the limit: must be in [0, 1e+100] rad/s".
+  /// Every value must be finite and within the limits above (kMaxSurfaceSpeed, ...), also when
+  /// multiplied by the largest value of a constant or ramp profile. Twist functions, function
+  /// profiles and fields cannot be checked here: they are checked at every step and contact.
   void validate(const std::string& where) const;
 
   /// Freeze the law at time `t` (s) for a step of `step` seconds (finite, >= 0; any other value
-  /// gives a law that is not finite(), whose problem() names it). `body_pose` is the pose of the
-  /// body carrying the feeder at time t (needed for Frame::Body, ignored otherwise; nullptr means
-  /// the world frame). The twist (profile applied; Frame::Body and twist functions first turned
-  /// into a world twist at t) is then held constant over the step. With `step` > 0 a law with w !=
-  /// 0 gives the secant surface velocity over the step (file comment); `step` = 0 gives the
-  /// instantaneous field v + w x (p - O).
+  /// gives a law that is not finite(), whose problem() names it). Never throws for a user
+  /// function: a profile or twist function that throws, or returns a value that is not finite
+  /// or beyond the limits, gives a law that is not finite() (threw() tells the first case).
+  /// `body_pose` is the pose of the body carrying the feeder at time t (needed for Frame::Body,
+  /// ignored otherwise; nullptr means the world frame). The twist (profile applied; Frame::Body and
+  /// twist functions first turned into a world twist at t) is then held constant over the step.
+  /// With `step` > 0 a law with w != 0 gives the secant surface velocity over the step (file
+  /// comment); `step` = 0 gives the instantaneous field v + w x (p - O).
   StepLaw evaluate(double t, const Pose* body_pose, double step = 0.0) const;
 
  private:
@@ -185,9 +217,10 @@ class StepLaw {
  public:
   /// Tangential surface velocity c_t (m/s, world) at contact point `p` (m, world) with unit
   /// normal `n`: the instantaneous field, or for a rotating law frozen with a step h > 0 the
-  /// secant over the step (file comment). Non-finite only if a user function returned a
-  /// non-finite value (then `isFinite` of the result is false and the caller leaves the contact
-  /// undriven).
+  /// secant over the step (file comment). Not finite, or beyond kMaxSurfaceSpeed, when a field
+  /// returned such a value or a long lever arm w x (p - O) exceeds the limit: the caller checks
+  /// and leaves the contact undriven. An exception thrown by a field propagates (FeederSet
+  /// catches it).
   Vec3 tangentialVelocity(const Vec3& p, const Vec3& n) const;
   /// The same for a contact of a rigid part whose centre of mass is at `carried` (m, world, at
   /// the start of the step): for a secant law, the velocity at `p` of the rigid motion that
@@ -202,9 +235,12 @@ class StepLaw {
   /// the carried body otherwise.
   bool usesCarriedPoint() const { return eval_ == Eval::Secant; }
 
-  /// Whether the frozen values are all finite (a profile or twist function can fail).
+  /// Whether the frozen values are all finite and within the limits (kMaxSurfaceSpeed, ...; a
+  /// profile or twist function can fail, or throw).
   bool finite() const { return finite_; }
-  /// Short description of the first non-finite value, empty if finite.
+  /// True if the law is not finite() because a profile or twist function threw.
+  bool threw() const { return threw_; }
+  /// Short description of the first bad value (or of the exception), empty if finite.
   const std::string& problem() const { return problem_; }
   /// True if every contact would get c_t = 0 (zero scale or zero twist).
   bool isZero() const { return eval_ == Eval::Zero; }
@@ -229,6 +265,7 @@ class StepLaw {
   double time_ = 0.0;
   bool time_varying_field_ = false;
   bool finite_ = true;
+  bool threw_ = false;
   std::string problem_;
 };
 

@@ -52,8 +52,11 @@ enum { rfAttachG1First = 0, rfAttachG2First = 1 };
 typedef void rfFieldFunction(void* user, const double p[3], const double n[3], double t,
                              double out[3]);
 
-/** A diagnostic: `kind` is one of "invalid_contact", "zero_friction", "law_not_finite",
- *  "force_cap_friction"; `message` names the value. Valid during the call only. */
+/** A diagnostic: `kind` is one of "invalid_contact", "zero_friction", "law_not_finite" (not
+ *  finite or beyond the speed limits of motion_law.hpp), "force_cap_friction", "law_threw" (a
+ *  C++ user function threw), "invalid_call" (rfFeederSetDriveContacts with a null array and
+ *  count > 0, or count < 0; `feeder` is 0 then); `message` names the value. Valid during the
+ *  call only. */
 typedef void rfDiagnosticFunction(void* user, const char* kind, dGeomID feeder,
                                   const char* message);
 
@@ -107,7 +110,14 @@ int rfFeederSetBeginStepDt(rfFeederSetID set, double time, double step);
 int rfFeederSetBeginStep(rfFeederSetID set, double time);
 /** Drive the feeder contacts of `contacts[0..count)`; returns how many contacts to create
  *  joints for (invalid feeder contacts are removed, the rest kept in order), or a negative
- *  rfError code. Safe to call from a near callback. */
+ *  rfError code: rfErrorInvalidArgument for a null set, a negative count, or a null `contacts`
+ *  with count > 0 (a caller bug: nothing is driven; the message is in rfFeederSetGetLastError
+ *  and the diagnostic function gets "invalid_call"). A loop `for (i = 0; i < n; ++i)` over
+ *  the result then creates no joint. Safe to call from a near callback.
+ *  Speeds: every law value at a contact must be finite and at most 1e100 m/s (kMaxSurfaceSpeed
+ *  of motion_law.hpp; twists: |w| <= 1e100 rad/s, origin coordinates within +-1e100 m), or the
+ *  contact is left undriven and reported as "law_not_finite"; the Add and Set functions refuse
+ *  such constant laws with rfErrorInvalidArgument. */
 int rfFeederSetDriveContacts(rfFeederSetID set, dContact* contacts, int count);
 
 /** Feeder contacts given fdir1/motion1 since the last rfFeederSetBeginStep, or a negative
