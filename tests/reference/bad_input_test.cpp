@@ -152,6 +152,33 @@ TEST(ReferenceBadInput, NegativeOrNanMuFromTheFrictionCallbackIsRefusedAtStep) {
   }
 }
 
+// The friction callback runs inside ODE's dSpaceCollide: its exception must not unwind through
+// ODE's C code. It comes out of step() after the collision pass, the step is not taken, and
+// the world steps normally afterwards.
+TEST(ReferenceBadInput, ExceptionFromTheFrictionCallbackComesOutOfStepNotThroughOde) {
+  initOdeOnce();
+  RestingBox scene(defaultSettings());
+  bool fail = true;
+  scene.world.setFrictionCallback([&fail](dGeomID, dGeomID) -> double {
+    if (fail) throw std::runtime_error("friction table has no entry for this pair");
+    return 0.5;
+  });
+  const BodyState before = scene.world.state(scene.box.id);
+  try {
+    scene.world.step(kStep);
+    ADD_FAILURE() << "the callback's exception was swallowed";
+  } catch (const std::runtime_error& e) {
+    RHEOFEED_EXPECT_CONTAINS(std::string(e.what()), "no entry for this pair");
+  }
+  EXPECT_EQ(scene.world.time(), 0.0);
+  EXPECT_EQ(scene.world.state(scene.box.id).position, before.position);
+  fail = false;
+  for (int i = 0; i < 100; ++i) scene.world.step(kStep);
+  // Resting on the floor: still there (not fallen through), no contact lost.
+  EXPECT_NEAR(scene.world.state(scene.box.id).position.z, before.position.z, 1e-3);
+  EXPECT_GT(scene.world.contacts().size(), 0u);
+}
+
 TEST(ReferenceBadInput, FeederLawsWithNanAreRefusedNamingTheValue) {
   initOdeOnce();
   RestingBox scene(defaultSettings());

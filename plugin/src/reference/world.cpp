@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
 #include <cmath>
+#include <exception>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -164,6 +165,7 @@ struct World::Impl {
 
   Settings settings;
   dSpaceID space = nullptr;
+  std::exception_ptr collide_error;  // first exception inside the near callback (rethrown)
   double time = 0;
   std::vector<Body> bodies;
   // Attached geoms and feeders in insertion order, with an index by geom for lookups. Loops run
@@ -235,10 +237,23 @@ struct World::Impl {
     }
   }
 
-  static void nearCallback(void* data, dGeomID o1, dGeomID o2) {
+  // ODE calls this from dSpaceCollide (C code): nothing may unwind through it. The first
+  // exception (a user friction callback, an allocation) is kept, the rest of the pass is skipped,
+  // and step() rethrows it once dSpaceCollide has returned.
+  static void nearCallback(void* data, dGeomID o1, dGeomID o2) noexcept {
     auto* self = static_cast<Impl*>(data);
+    if (self->collide_error) return;
+    try {
+      self->collidePair(o1, o2);
+    } catch (...) {
+      self->collide_error = std::current_exception();
+    }
+  }
+
+  void collidePair(dGeomID o1, dGeomID o2) {
+    Impl* self = this;
     if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) {
-      dSpaceCollide2(o1, o2, data, &nearCallback);
+      dSpaceCollide2(o1, o2, self, &nearCallback);
       return;
     }
     const BodyId a = self->bodyOf(o1), b = self->bodyOf(o2);
@@ -511,7 +526,12 @@ StepReport World::step(double h) {
   s.placeGeoms();
   s.freezeLaws(h);
   s.raw.clear();
+  s.collide_error = nullptr;
   dSpaceCollide(s.space, &s, &Impl::nearCallback);
+  if (s.collide_error) {
+    s.raw.clear();
+    std::rethrow_exception(std::exchange(s.collide_error, nullptr));
+  }
 
   const int nc = static_cast<int>(s.raw.size());
   report.contacts = nc;
