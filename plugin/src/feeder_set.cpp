@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "current_exception.hpp"
 #include "ode_vec.hpp"
 
 namespace rheofeed {
@@ -182,17 +183,6 @@ struct FeederSet::Impl {
       // A diagnostic must never unwind into ODE.
     }
     invalid_call_reported = true;
-  }
-
-  // The message of the exception being handled (inside a catch block only).
-  static std::string describeCurrent() {
-    try {
-      throw;
-    } catch (const std::exception& e) {
-      return e.what();
-    } catch (...) {
-      return "an exception that is not a std::exception";
-    }
   }
 
   static void wake(dBodyID body, Feeder& f) {
@@ -428,7 +418,7 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
         s.report(*f, DiagnosticKind::LawThrew, [&] {
           std::ostringstream out;
           out << "law threw at p = (" << p.x << ", " << p.y << ", " << p.z << "), t = " << s.time
-              << ": " << Impl::describeCurrent() << "; contact left undriven";
+              << ": " << detail::currentExceptionMessage() << "; contact left undriven";
           return out.str();
         });
       }

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "current_exception.hpp"
+
 namespace rheofeed {
 namespace {
 
@@ -89,17 +91,6 @@ std::string firstNonFinite(const Twist& t) {
     return out.str();
   }
   return {};
-}
-
-// The message of the exception being handled (call inside a catch block only).
-std::string describe() {
-  try {
-    throw;
-  } catch (const std::exception& e) {
-    return e.what();
-  } catch (...) {
-    return "an exception that is not a std::exception";
-  }
 }
 
 }  // namespace
@@ -326,7 +317,8 @@ StepLaw MotionLaw::evaluate(double t, const Pose* body_pose, double step) const 
   } catch (...) {
     s.finite_ = false;
     s.threw_ = true;
-    s.problem_ = "profile function threw at t = " + std::to_string(t) + ": " + describe();
+    s.problem_ = "profile function threw at t = " + std::to_string(t) + ": " +
+                 detail::currentExceptionMessage();
     return s;
   }
   if (!std::isfinite(s.scale_)) {
@@ -348,7 +340,8 @@ StepLaw MotionLaw::evaluate(double t, const Pose* body_pose, double step) const 
     } catch (...) {
       s.finite_ = false;
       s.threw_ = true;
-      s.problem_ = "twist function threw at t = " + std::to_string(t) + ": " + describe();
+      s.problem_ = "twist function threw at t = " + std::to_string(t) + ": " +
+                   detail::currentExceptionMessage();
       return s;
     }
     const std::string bad = firstNonFinite(tw);

@@ -121,10 +121,7 @@ class OdeSimulation final : public PartSimulation {
     dBodyID b = parts_.at(static_cast<std::size_t>(i));
     dBodySetPosition(b, last.position.x, last.position.y, last.position.z);
     dMatrix3 r;
-    for (int row = 0; row < 3; ++row) {
-      for (int col = 0; col < 3; ++col) r[4 * row + col] = last.rotation[3 * row + col];
-      r[4 * row + 3] = 0;
-    }
+    toOdeMatrix(last.rotation, r);
     dBodySetRotation(b, r);
     dBodySetLinearVel(b, 0, 0, 0);
     dBodySetAngularVel(b, 0, 0, 0);
@@ -134,12 +131,14 @@ class OdeSimulation final : public PartSimulation {
 
  private:
   static Vec3 vec(const dReal* a) { return {a[0], a[1], a[2]}; }
-  static void toOdeMatrix(const Pose& p, dMatrix3 r) {
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) r[4 * i + j] = p.rotation[3 * i + j];
-      r[4 * i + 3] = 0;
+  // A row-major 3x3 rotation (body to world) as ODE's 3x4 matrix.
+  static void toOdeMatrix(const double rotation[9], dMatrix3 r) {
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 3; ++col) r[4 * row + col] = rotation[3 * row + col];
+      r[4 * row + 3] = 0;
     }
   }
+  static void toOdeMatrix(const Pose& p, dMatrix3 r) { toOdeMatrix(p.rotation, r); }
 
   // ODE's generator is 32 bits wide: the scene seed mixed (splitmix64) and cut to 32 bits.
   static unsigned long randomSeed(std::uint64_t seed) {
