@@ -103,7 +103,7 @@ double relativeResidual(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
   for (Eigen::Index i = 0; i < mu.size(); ++i) {
     const Eigen::Vector3d g = gamma.segment<3>(3 * i);
     Eigen::Vector3d velocity = u.segment<3>(3 * i);
-    if (coulomb) velocity[0] += mu[i] * velocity.tail<2>().norm();
+    if (coulomb) velocity[0] += mu[i] * std::hypot(velocity[1], velocity[2]);
     // rho / lambda_i is the block step of PGS (kg): impulse and velocity terms of the map then
     // scale alike when N or r is scaled, and dividing by it again gives a velocity.
     const double step = rho / ws.lambda[i];
@@ -262,7 +262,7 @@ Result Solver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
   };
   auto updateShift = [&](Eigen::VectorXd& shift) {
     for (Eigen::Index i = 0; i < nc; ++i)
-      shift[i] = problem.mu[i] * ws.u.segment<2>(3 * i + 1).norm();
+      shift[i] = problem.mu[i] * std::hypot(ws.u[3 * i + 1], ws.u[3 * i + 2]);
   };
 
   detail::InnerOutcome outcome;
