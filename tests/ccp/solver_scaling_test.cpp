@@ -153,7 +153,9 @@ TEST(ScaledFc3d, SolutionsAndIterationCountsFollowTheScaling) {
             EXPECT_LE(test::relativeResidual(problem.delassus, gamma, problem.r, problem.mu),
                       kTolerance);
           } else {
-            EXPECT_LE(result.coulomb_distance, kTolerance);
+            // Coulomb mode also converges on a settled shift (solver.hpp): its Coulomb residual
+            // is the inner residual plus the last shift change (fc3d_problems_test.cpp).
+            EXPECT_LE(result.coulomb_distance, 2.0 * kTolerance);
           }
         }
       }

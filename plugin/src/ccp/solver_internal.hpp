@@ -91,6 +91,7 @@ template <class Derived>
 double safeNorm(const Eigen::MatrixBase<Derived>& x) {
   const double squared = x.squaredNorm();
   if (squared >= kMinSafeSquaredNorm && squared <= kMaxSafeSquaredNorm) return std::sqrt(squared);
+  if (x.size() == 0) return 0.0;
   if (!x.allFinite()) return std::numeric_limits<double>::quiet_NaN();
   const double largest = x.cwiseAbs().maxCoeff();
   if (largest == 0.0) return 0.0;
