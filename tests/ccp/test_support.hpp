@@ -53,6 +53,28 @@ inline double naturalMapResidual(const Eigen::VectorXd& gamma, const Eigen::Vect
   return naturalMap(gamma, u, mu) / (1.0 + r.norm());
 }
 
+/// The solver's relative residual (solver.hpp, Result::residual) recomputed for a dense N with
+/// rho = 1: per contact the step s_i = 3 / trace(N_ii) (kg) and the velocity-form natural map
+/// v_i = (gamma_i - Pi_K(gamma_i - s_i u_i)) / s_i (m/s); the result is
+/// ||v|| / max(||r||, ||u - r||) (dimensionless; 0 when v = 0). With `coulomb`, u_n is replaced by
+/// De Saxce's u_n + mu ||u_t||. Plain sums of squares: only for data whose squares neither
+/// overflow nor underflow.
+inline double relativeResidual(const Eigen::MatrixXd& n, const Eigen::VectorXd& gamma,
+                               const Eigen::VectorXd& r, const Eigen::VectorXd& mu,
+                               bool coulomb = false) {
+  const Eigen::VectorXd u = n * gamma + r;
+  double sum = 0.0;
+  for (Eigen::Index i = 0; i < mu.size(); ++i) {
+    const double step = 3.0 / n.block<3, 3>(3 * i, 3 * i).trace();
+    const Eigen::Vector3d g = gamma.segment<3>(3 * i);
+    Eigen::Vector3d ui = u.segment<3>(3 * i);
+    if (coulomb) ui(0) += mu(i) * std::hypot(ui(1), ui(2));
+    sum += ((g - referenceConeProjection(g - step * ui, mu(i))) / step).squaredNorm();
+  }
+  if (sum == 0.0) return 0.0;
+  return std::sqrt(sum) / std::max(r.norm(), (u - r).norm());
+}
+
 /// Natural map residual of the true Coulomb law: as naturalMapResidual with u_n replaced by
 /// De Saxce's u_n + mu ||u_t||.
 inline double coulombResidual(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,

@@ -59,7 +59,6 @@ InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Eig
                      const Settings& settings, const Deadline& deadline, Eigen::VectorXd& gamma,
                      Workspace& ws) {
   const Eigen::Index nc = problem.numContacts();
-  const double scale = 1.0 + r.norm();
   const double rho = settings.residual_rho;
   InnerOutcome out;
 
@@ -73,7 +72,7 @@ InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Eig
   // Lipschitz estimate from the ones vector (y, n_y used as scratch).
   y.setOnes();
   multiplyDelassus(problem, y, n_y, ws);
-  double lipschitz = n_y.norm() / std::sqrt(double(y.size()));
+  double lipschitz = safeNorm(n_y) / std::sqrt(double(y.size()));
   if (!(lipschitz > 0.0) || !std::isfinite(lipschitz)) {
     lipschitz = 0.0;
     for (Eigen::Index i = 0; i < nc; ++i) {
@@ -84,7 +83,7 @@ InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Eig
   gk = gamma;
   multiplyDelassus(problem, gk, n_gk, ws);
   ws.u = n_gk + r;
-  double best_residual = naturalMap(gk, ws.u, mu, rho) / scale;
+  double best_residual = relativeResidual(gk, ws.u, r, mu, rho, false, ws);
   ws.best = gk;
   out.residual = best_residual;
   if (!std::isfinite(best_residual)) {
@@ -114,10 +113,17 @@ InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Eig
         next.segment<3>(3 * i) = projectOntoCone(trial, mu[i]);
       }
       multiplyDelassus(problem, next, n_next, ws);
-      // d^T N d <= L ||d||^2 with d = next - y, N d = n_next - n_y.
-      const double curvature = (next - y).dot(n_next - n_y);
-      const double squared_step = (next - y).squaredNorm();
-      const double slack = kBacktrackSlack * std::sqrt(squared_step) * (n_next.norm() + n_y.norm());
+      // d^T N d <= L ||d||^2 with d = next - y, N d = n_next - n_y, both sides divided by
+      // max|d_i|^2 so that neither overflows nor underflows on data far from 1.
+      const double d_max = (next - y).cwiseAbs().maxCoeff();
+      if (d_max == 0.0) {
+        accepted = true;  // y is a fixed point of the projected step
+        break;
+      }
+      const double curvature = ((next - y) / d_max).dot((n_next - n_y) / d_max);
+      const double squared_step = ((next - y) / d_max).squaredNorm();
+      const double slack =
+          kBacktrackSlack * std::sqrt(squared_step) * (safeNorm(n_next) + safeNorm(n_y)) / d_max;
       if (curvature <= lipschitz * squared_step + slack) {
         accepted = true;
         break;
@@ -132,7 +138,7 @@ InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Eig
 
     // Residual of the new iterate, from the fresh product N gamma_{k+1}.
     ws.u = n_next + r;
-    const double residual = naturalMap(next, ws.u, mu, rho) / scale;
+    const double residual = relativeResidual(next, ws.u, r, mu, rho, false, ws);
     if (!std::isfinite(residual)) {
       out.status = Status::NumericalIssue;
       out.issue = "APGD: non-finite residual (impulses or velocities overflowed)";
@@ -147,8 +153,12 @@ InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Eig
       break;
     }
 
-    // Gradient restart test: grad f(y_k)^T (gamma_{k+1} - gamma_k) > 0.
-    const bool restart = (n_y + r).dot(next - gk) > 0.0;
+    // Gradient restart test: grad f(y_k)^T (gamma_{k+1} - gamma_k) > 0, each factor divided by
+    // its largest entry (the sign is all that matters; the product could overflow).
+    const double gradient_max = (n_y + r).cwiseAbs().maxCoeff();
+    const double move_max = (next - gk).cwiseAbs().maxCoeff();
+    const bool restart = gradient_max > 0.0 && move_max > 0.0 &&
+                         ((n_y + r) / gradient_max).dot((next - gk) / move_max) > 0.0;
     const double theta_next = 0.5 * (-theta * theta + theta * std::sqrt(theta * theta + 4.0));
     if (restart) {
       y = next;

@@ -128,7 +128,6 @@ InnerOutcome pgsLoop(Contacts& contacts, const Problem& problem, const Eigen::Ve
                      const Eigen::VectorXd& mu, const Settings& settings, const Deadline& deadline,
                      Eigen::VectorXd& gamma, Workspace& ws) {
   const Eigen::Index nc = problem.numContacts();
-  const double scale = 1.0 + r.norm();
   const double rho = settings.residual_rho;
   for (Eigen::Index i = 0; i < nc; ++i) {
     const Eigen::Matrix3d block = problem.diagonalBlock(i);
@@ -141,9 +140,14 @@ InnerOutcome pgsLoop(Contacts& contacts, const Problem& problem, const Eigen::Ve
   InnerOutcome out;
   contacts.refresh(gamma);
   contacts.updateVelocity();
-  out.residual = naturalMap(gamma, ws.u, mu, rho) / scale;
+  out.residual = relativeResidual(gamma, ws.u, r, mu, rho, false, ws);
   ws.best = gamma;
   double best_residual = out.residual;
+  if (!std::isfinite(out.residual)) {
+    out.status = Status::NumericalIssue;
+    out.issue = "PGS: non-finite residual at the initial guess";
+    return out;
+  }
   if (out.residual <= settings.tolerance) {
     out.status = Status::Converged;
     return out;
@@ -165,7 +169,7 @@ InnerOutcome pgsLoop(Contacts& contacts, const Problem& problem, const Eigen::Ve
     const bool refreshed = sweep % settings.pgs_refresh_interval == 0;
     if (refreshed) contacts.refresh(gamma);
     contacts.updateVelocity();
-    double residual = naturalMap(gamma, ws.u, mu, rho) / scale;
+    double residual = relativeResidual(gamma, ws.u, r, mu, rho, false, ws);
     if (!std::isfinite(residual)) {
       out.status = Status::NumericalIssue;
       out.issue = "PGS: non-finite residual (impulses or velocities overflowed)";
@@ -175,7 +179,7 @@ InnerOutcome pgsLoop(Contacts& contacts, const Problem& problem, const Eigen::Ve
       // Confirm with drift-free velocities before declaring convergence.
       contacts.refresh(gamma);
       contacts.updateVelocity();
-      residual = naturalMap(gamma, ws.u, mu, rho) / scale;
+      residual = relativeResidual(gamma, ws.u, r, mu, rho, false, ws);
     }
     if (residual < best_residual) {
       best_residual = residual;

@@ -54,9 +54,9 @@ namespace detail {
 void Workspace::resize(Eigen::Index nc, Eigen::Index ndof) {
   const Eigen::Index n = 3 * nc;
   for (Eigen::VectorXd* v : {&u, &r_shifted, &iterate, &n_iterate, &next, &n_next, &y, &n_y, &best,
-                             &coulomb_best, &coulomb_start, &friction, &r_normal})
+                             &coulomb_best, &coulomb_start, &friction, &r_normal, &map})
     v->resize(n);
-  for (Eigen::VectorXd* v : {&eta, &shift, &shift_new, &zero_mu}) v->resize(nc);
+  for (Eigen::VectorXd* v : {&lambda, &eta, &shift, &shift_new, &zero_mu}) v->resize(nc);
   dof_a.resize(ndof);
   dof_b.resize(ndof);
 }
@@ -91,15 +91,32 @@ void multiplyDelassus(const Problem& problem, const Eigen::VectorXd& x, Eigen::V
   }
 }
 
-double naturalMap(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u, const Eigen::VectorXd& mu,
-                  double rho) {
-  double sum = 0.0;
+void computeContactScales(const Problem& problem, Workspace& ws) {
+  for (Eigen::Index i = 0; i < problem.numContacts(); ++i) {
+    ws.lambda[i] = problem.diagonalBlock(i).trace() / 3.0;
+  }
+}
+
+double relativeResidual(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
+                        const Eigen::VectorXd& r, const Eigen::VectorXd& mu, double rho,
+                        bool coulomb, Workspace& ws) {
   for (Eigen::Index i = 0; i < mu.size(); ++i) {
     const Eigen::Vector3d g = gamma.segment<3>(3 * i);
-    const Eigen::Vector3d trial = g - rho * u.segment<3>(3 * i);
-    sum += (g - projectOntoCone(trial, mu[i])).squaredNorm();
+    Eigen::Vector3d velocity = u.segment<3>(3 * i);
+    if (coulomb) velocity[0] += mu[i] * std::hypot(velocity[1], velocity[2]);
+    // rho / lambda_i is the block step of PGS (kg): impulse and velocity terms of the map then
+    // scale alike when N or r is scaled, and dividing by it again gives a velocity.
+    const double step = rho / ws.lambda[i];
+    ws.map.segment<3>(3 * i) = (g - projectOntoCone(g - step * velocity, mu[i])) / step;
   }
-  return std::sqrt(sum);
+  const double error = safeNorm(ws.map);
+  const double scale = std::max(safeNorm(r), safeNorm(u - r));
+  if (!std::isfinite(error) || !std::isfinite(scale)) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  // scale == 0 means u = 0 and N gamma = 0; with gamma in K the map is then exactly zero.
+  if (error == 0.0) return 0.0;
+  return scale > 0.0 ? error / scale : std::numeric_limits<double>::infinity();
 }
 
 void projectOntoCones(Eigen::VectorXd& gamma, const Eigen::VectorXd& mu) {
@@ -118,24 +135,10 @@ std::string format(const char* fmt, double a, double b = 0.0) {
   return std::string(buffer);
 }
 
-// Unscaled natural map of the true Coulomb law (u_n replaced by u_n + mu ||u_t||).
-double coulombResidual(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
-                       const Eigen::VectorXd& mu, double rho) {
-  double sum = 0.0;
-  for (Eigen::Index i = 0; i < mu.size(); ++i) {
-    const Eigen::Vector3d g = gamma.segment<3>(3 * i);
-    Eigen::Vector3d modified = u.segment<3>(3 * i);
-    modified[0] += mu[i] * modified.tail<2>().norm();
-    sum += (g - projectOntoCone(g - rho * modified, mu[i])).squaredNorm();
-  }
-  return std::sqrt(sum);
-}
-
 // Fills the measures of `result` for impulses gamma with u = N gamma + r (u given).
 void computeMeasures(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
                      const Eigen::VectorXd& r, const Eigen::VectorXd& mu, double rho,
-                     Result& result) {
-  const double scale = 1.0 + r.norm();
+                     detail::Workspace& ws, Result& result) {
   double dual = 0.0;
   double complementarity = 0.0;
   for (Eigen::Index i = 0; i < mu.size(); ++i) {
@@ -148,7 +151,7 @@ void computeMeasures(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
   result.complementarity = complementarity;
   // 1/2 g^T N g + r^T g with N g = u - r.
   result.objective = 0.5 * gamma.dot(u + r);
-  result.coulomb_distance = coulombResidual(gamma, u, mu, rho) / scale;
+  result.coulomb_distance = detail::relativeResidual(gamma, u, r, mu, rho, true, ws);
 }
 
 }  // namespace
@@ -237,6 +240,7 @@ Result Solver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
   if (!workspace_) workspace_ = std::make_unique<Workspace>();
   detail::Workspace& ws = *workspace_;
   ws.resize(nc, problem.numDofs());
+  detail::computeContactScales(problem, ws);
 
   const bool warm = settings_.warm_start && gamma.size() == n && gamma.allFinite();
   if (warm) {
@@ -258,7 +262,7 @@ Result Solver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
   };
   auto updateShift = [&](Eigen::VectorXd& shift) {
     for (Eigen::Index i = 0; i < nc; ++i)
-      shift[i] = problem.mu[i] * ws.u.segment<2>(3 * i + 1).norm();
+      shift[i] = problem.mu[i] * std::hypot(ws.u[3 * i + 1], ws.u[3 * i + 2]);
   };
 
   detail::InnerOutcome outcome;
@@ -277,7 +281,13 @@ Result Solver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
     // converged from gamma = 0). Every iterate, the relaxed one included, is judged by its own
     // Coulomb residual for the problem's r, and the best one is returned when the fixed point
     // does not settle.
-    const double scale = 1.0 + problem.r.norm();
+    const double rho = settings_.residual_rho;
+    // A non-finite Coulomb residual or shift (overflow of mu ||u_t|| or of N gamma) ends the
+    // loop as a numerical issue, never as an iteration limit.
+    auto numericalIssue = [&](const char* issue) {
+      outcome.status = Status::NumericalIssue;
+      outcome.issue = issue;
+    };
     ws.coulomb_start = gamma;
     ws.shift.setZero();
     bool fixed_point_reached = false;
@@ -293,7 +303,13 @@ Result Solver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
       if (outcome.status == Status::NumericalIssue || outcome.timed_out) break;
       physicalVelocity();
       const double coulomb =
-          coulombResidual(gamma, ws.u, problem.mu, settings_.residual_rho) / scale;
+          detail::relativeResidual(gamma, ws.u, problem.r, problem.mu, rho, true, ws);
+      if (!std::isfinite(coulomb)) {
+        numericalIssue(
+            "Coulomb mode: non-finite Coulomb residual (impulses or velocities "
+            "overflowed)");
+        break;
+      }
       // The relaxed iterate is returned only as a Coulomb solution (below): as a best-effort
       // answer it would separate every sliding contact at mu ||u_t||, which is what Coulomb
       // mode exists to avoid. (With coulomb_outer_iterations == 1 it is the only iterate.)
@@ -311,10 +327,23 @@ Result Solver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
         gamma = ws.coulomb_start;
         physicalVelocity();
         updateShift(ws.shift);
+        if (!ws.shift.allFinite()) {
+          numericalIssue("Coulomb mode: non-finite normal shift mu ||u_t|| (overflow)");
+          break;
+        }
         continue;
       }
       updateShift(ws.shift_new);
-      change = (ws.shift_new - ws.shift).norm() / scale;
+      if (!ws.shift_new.allFinite()) {
+        numericalIssue("Coulomb mode: non-finite normal shift mu ||u_t|| (overflow)");
+        break;
+      }
+      // Dimensionless like the residual: the shift (m/s) relative to the velocity scale
+      // max(||r||, ||N gamma||) of the current iterate.
+      const double velocity_scale =
+          std::max(detail::safeNorm(problem.r), detail::safeNorm(ws.u - problem.r));
+      const double shift_change = detail::safeNorm(ws.shift_new - ws.shift);
+      change = shift_change == 0.0 ? 0.0 : shift_change / velocity_scale;
       ws.shift.swap(ws.shift_new);
       if (change <= settings_.coulomb_tolerance && outcome.status == Status::Converged) {
         fixed_point_reached = true;
@@ -381,7 +410,7 @@ Result Solver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
           // The corrected impulses may satisfy the Coulomb law to the tolerance themselves.
           physicalVelocity();
           const double coulomb =
-              coulombResidual(gamma, ws.u, problem.mu, settings_.residual_rho) / scale;
+              detail::relativeResidual(gamma, ws.u, problem.r, problem.mu, rho, true, ws);
           if (coulomb <= settings_.tolerance) fixed_point_reached = true;
         }
       }
@@ -403,10 +432,10 @@ Result Solver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
     result.message = format("time limit of %g s reached", deadline.limit());
   }
   physicalVelocity();
-  computeMeasures(gamma, ws.u, problem.r, problem.mu, settings_.residual_rho, result);
+  computeMeasures(gamma, ws.u, problem.r, problem.mu, settings_.residual_rho, ws, result);
   if (settings_.coulomb_outer_iterations == 0) {
-    result.residual = detail::naturalMap(gamma, ws.u, problem.mu, settings_.residual_rho) /
-                      (1.0 + problem.r.norm());
+    result.residual = detail::relativeResidual(gamma, ws.u, problem.r, problem.mu,
+                                               settings_.residual_rho, false, ws);
   } else {
     result.residual = outcome.residual;
   }

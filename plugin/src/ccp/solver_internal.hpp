@@ -10,8 +10,16 @@
 #include <Eigen/Core>
 
 #include <chrono>
+#include <cmath>
+#include <limits>
 
 namespace rheofeed::ccp::detail {
+
+/// Range of squared norms summed directly by safeNorm(): below, subnormal squares lose digits;
+/// above, the sum may have overflowed.
+constexpr double kMinSafeSquaredNorm =
+    std::numeric_limits<double>::min() / std::numeric_limits<double>::epsilon();
+constexpr double kMaxSafeSquaredNorm = 0.5 * std::numeric_limits<double>::max();
 
 /// Preallocated vectors. resize() only allocates when a size changes.
 struct Workspace {
@@ -29,7 +37,9 @@ struct Workspace {
   Eigen::VectorXd coulomb_start;  // Coulomb mode: the incoming gamma (start of the shift iteration)
   Eigen::VectorXd friction;       // frozen-friction correction: gamma with its normals zeroed
   Eigen::VectorXd r_normal;       // frozen-friction correction: r + N friction
+  Eigen::VectorXd map;            // velocity-form natural map of the residual (m/s)
   // Contacts (nc).
+  Eigen::VectorXd lambda;     // mean eigenvalue trace(N_ii) / 3 of each diagonal block (1/kg)
   Eigen::VectorXd eta;        // PGS block step 3 / trace(N_ii)
   Eigen::VectorXd shift;      // Coulomb mode: current s_i = mu_i ||u_t,i||
   Eigen::VectorXd shift_new;  // Coulomb mode: next s_i
@@ -62,7 +72,7 @@ class Deadline {
 struct InnerOutcome {
   Status status = Status::NotRun;
   int iterations = 0;
-  /// Scaled natural map residual of the returned iterate.
+  /// Relative residual (relativeResidual()) of the returned iterate.
   double residual = 0.0;
   /// True when the time budget stopped the solve.
   bool timed_out = false;
@@ -74,9 +84,32 @@ struct InnerOutcome {
 void multiplyDelassus(const Problem& problem, const Eigen::VectorXd& x, Eigen::VectorXd& y,
                       Workspace& ws);
 
-/// Unscaled natural map `||gamma - Pi_K(gamma - rho u)||` (impulse units).
-double naturalMap(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u, const Eigen::VectorXd& mu,
-                  double rho);
+/// Euclidean norm of `x` that neither overflows nor underflows: the plain sum of squares when
+/// it is a normal number, else the norm of `x / max|x_i|` times `max|x_i|`. Non-finite entries
+/// give a non-finite result. No heap allocation (x may be an expression).
+template <class Derived>
+double safeNorm(const Eigen::MatrixBase<Derived>& x) {
+  const double squared = x.squaredNorm();
+  if (squared >= kMinSafeSquaredNorm && squared <= kMaxSafeSquaredNorm) return std::sqrt(squared);
+  if (x.size() == 0) return 0.0;
+  if (!x.allFinite()) return std::numeric_limits<double>::quiet_NaN();
+  const double largest = x.cwiseAbs().maxCoeff();
+  if (largest == 0.0) return 0.0;
+  return largest * (x / largest).norm();
+}
+
+/// Fills ws.lambda with the mean eigenvalue trace(N_ii) / 3 (1/kg, > 0 for a valid problem) of
+/// every diagonal block. Called once per Solver::solve.
+void computeContactScales(const Problem& problem, Workspace& ws);
+
+/// The dimensionless relative residual of solver.hpp (Result::residual): with
+/// `v_i = (lambda_i / rho) (gamma_i - Pi_K(gamma_i - (rho / lambda_i) u_i))` (m/s),
+/// `||v|| / max(||r||, ||u - r||)`, and 0 when both scales and v are zero. With `coulomb`, u_n is
+/// replaced by De Saxce's `u_n + mu ||u_t||` (Result::coulomb_distance). Uses ws.lambda and
+/// ws.map. Non-finite data give a non-finite result.
+double relativeResidual(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
+                        const Eigen::VectorXd& r, const Eigen::VectorXd& mu, double rho,
+                        bool coulomb, Workspace& ws);
 
 /// Projects every contact block of `gamma` onto its friction cone, in place.
 void projectOntoCones(Eigen::VectorXd& gamma, const Eigen::VectorXd& mu);

@@ -13,18 +13,28 @@
 /// strings).
 ///
 /// Quality measures (Result), all computed from the returned gamma with `u = N gamma + r`, with
-/// per contact i the friction cone K_i, its dual K_i* and rho = Settings::residual_rho:
-/// - residual: `||gamma - Pi_K(gamma - rho u)|| / (1 + ||r||)` (Euclidean norm over all
-///   contacts), the natural map of the CCP; zero exactly at a solution, and the stopping test.
+/// per contact i the friction cone K_i, its dual K_i*, `lambda_i = trace(N_ii) / 3` (1/kg, the
+/// block's mean eigenvalue) and `rho = Settings::residual_rho` (dimensionless):
+/// - residual (the stopping test), dimensionless and invariant to scaling the problem
+///   (`N -> a N`, `r -> b r` maps solutions by `gamma -> (b / a) gamma`, `u -> b u` and leaves
+///   it unchanged; PGS and APGD then take the same iterations):
+///       `||v|| / max(||r||, ||N gamma||)`,  `v_i = (gamma_i - Pi_K(gamma_i - s_i u_i)) / s_i`,
+///   with `s_i = rho / lambda_i` (kg) the PGS block step, so `v` is the natural map of the CCP in
+///   velocity units (m/s; `v_i = u_i` for a sticking contact, 0 for a separated one). The
+///   denominator (m/s) is the problem's own velocity scale; it is zero only when `u = 0` and
+///   `N gamma = 0`, where `v = 0` too and the residual is defined as 0 (no absolute floor: a
+///   problem with `r` scaled by 1e-9 is solved as the unscaled one). Norms are computed without
+///   overflow or underflow (data from about 1e-150 to 1e300 is handled).
 /// - dual_infeasibility: `sqrt(sum_i dist(u_i, K_i*)^2)` with `dist(u, K*) = ||Pi_K(-u)||` (m/s),
 ///   how far the velocities are from the relaxed law `u_n >= mu ||u_t||`.
 /// - complementarity: `sum_i |gamma_i . u_i|` (N m), zero at a solution (per-contact absolute
 ///   values, so that contacts cannot cancel each other).
 /// - objective: `1/2 gamma^T N gamma + r^T gamma` (J), minimal at the solution.
-/// - coulomb_distance: the natural map residual of the true Coulomb law, `u_n` replaced by
-///   `u_n + mu ||u_t||` (De Saxce's modified velocity), same normalisation as residual. It
-///   equals the relaxed residual where no contact slides. With rho = 1 it is comparable to the
-///   error measure of Siconos for fc3d problems (same modified velocity; other normalisation).
+/// - coulomb_distance: the residual of the true Coulomb law, `u_n` replaced by
+///   `u_n + mu ||u_t||` (De Saxce's modified velocity) in `v`, same normalisation as residual.
+///   It equals the relaxed residual where no contact slides.
+/// The absolute measures (dual_infeasibility, complementarity, objective) are not scale invariant
+/// and not used for stopping; they are reported as computed.
 
 #include "rheofeed/ccp/problem.hpp"
 
@@ -59,9 +69,12 @@ enum class Status {
   /// mode: the shifted outer iterate with the lowest Coulomb residual, its normal impulses
   /// corrected as Settings::coulomb_max_separation says).
   MaxIterations,
-  /// A non-finite value appeared during the iterations; gamma is the last finite best iterate.
+  /// A non-finite value appeared during the iterations (an overflow of finite data: impulses,
+  /// velocities, or in Coulomb mode the shift mu ||u_t|| or the Coulomb residual); gamma is the
+  /// last finite best iterate. Never reported as MaxIterations.
   NumericalIssue,
-  /// Problem::validate() or the settings refused the input; gamma is untouched.
+  /// Problem::validate() or the settings refused the input (e.g. a NaN or infinity in r, mu or
+  /// N); gamma is untouched.
   InvalidInput,
 };
 
@@ -75,10 +88,11 @@ struct Settings {
   /// Iteration budget of one relaxed solve: PGS sweeps over all contacts, or APGD iterations
   /// (>= 1). In Coulomb mode it applies to each inner solve.
   int max_iterations = 10000;
-  /// Stop when the natural map residual (see Result::residual, dimensionless by its
-  /// normalisation for consistent units) is at or below this value (>= 0).
+  /// Stop when the relative residual (see Result::residual and this file's header: dimensionless
+  /// and invariant to the units of N and r) is at or below this value (>= 0).
   double tolerance = 1e-8;
-  /// Scale rho of the natural map `gamma - Pi_K(gamma - rho u)` (unit: N s per m/s = kg; > 0).
+  /// Multiplier rho of the per-contact natural map step `s_i = rho / lambda_i` (kg) of the
+  /// residual (dimensionless, > 0; 1 uses the PGS block step 3 / trace(N_ii)).
   double residual_rho = 1.0;
   /// PGS over-relaxation (dimensionless, 0 < omega < 2; 1 means none): the block step of contact
   /// i is `min(omega * 3 / trace(N_ii), 1.9 / lambda_max(N_ii))` (unit: impulse per velocity,
@@ -104,8 +118,9 @@ struct Settings {
   /// sliding contacts separate at mu ||u_t||, unless k == 1), with the frozen-friction normal
   /// correction (see coulomb_max_separation) when it separates a pressed contact.
   int coulomb_outer_iterations = 0;
-  /// Coulomb mode stops when `||s_new - s_old|| / (1 + ||r||) <= coulomb_tolerance`, where
-  /// `s_i = mu_i ||u_t,i||` (m/s) is the normal shift (>= 0, dimensionless like tolerance).
+  /// Coulomb mode stops when `||s_new - s_old|| / max(||r||, ||N gamma||) <= coulomb_tolerance`
+  /// (a converged inner solve assumed), where `s_i = mu_i ||u_t,i||` (m/s) is the normal shift
+  /// (>= 0, dimensionless and scale invariant like tolerance).
   double coulomb_tolerance = 1e-8;
   /// Coulomb mode, when the fixed point does not settle: the best iterate is returned as is when
   /// no contact that carries a normal impulse separates faster than this (m/s, >= 0; infinity
@@ -147,9 +162,9 @@ struct Result {
   /// Coulomb mode, when the fixed point did not settle: the largest normal velocity (m/s) of a
   /// contact carrying a normal impulse in the best iterate, before any correction (0 otherwise).
   double best_iterate_separation = 0.0;
-  /// Natural map residual of the relaxed problem solved, `/(1 + ||r||)` (dimensionless for
-  /// consistent units). In Coulomb mode: of the inner solve that produced the returned gamma,
-  /// with its shifted `r`.
+  /// Relative residual (dimensionless, scale invariant; this file's header) of the relaxed
+  /// problem solved. In Coulomb mode: of the inner solve that produced the returned gamma, with
+  /// its shifted `r`.
   double residual = std::numeric_limits<double>::quiet_NaN();
   /// Distance of `u` to the dual cones (m/s), for the problem's own `r`.
   double dual_infeasibility = std::numeric_limits<double>::quiet_NaN();
@@ -157,7 +172,7 @@ struct Result {
   double complementarity = std::numeric_limits<double>::quiet_NaN();
   /// `1/2 gamma^T N gamma + r^T gamma` (J), for the problem's own `r`.
   double objective = std::numeric_limits<double>::quiet_NaN();
-  /// Natural map residual of the true Coulomb law, for the problem's own `r`.
+  /// Relative residual of the true Coulomb law (dimensionless), for the problem's own `r`.
   double coulomb_distance = std::numeric_limits<double>::quiet_NaN();
   /// Wall-clock time of solve() (s).
   double solve_time_s = 0.0;
