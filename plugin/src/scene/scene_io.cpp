@@ -29,8 +29,6 @@ using ojson = nlohmann::ordered_json;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kFormatVersion = 1;
-// Distribution::max when a file gives none (scene.hpp's default: unbounded).
-constexpr double kUnbounded = Distribution{}.max;
 
 [[noreturn]] void fail(const std::string& path, const std::string& problem) {
   throw SceneFileError("", path, problem);
