@@ -13,7 +13,6 @@ namespace {
 
 using ojson = nlohmann::ordered_json;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kFormatVersion = 1;  // as scene_io.cpp reads it
 // Distribution::max when a file gives none (scene.hpp's default: unbounded).
 constexpr double kUnbounded = Distribution{}.max;
