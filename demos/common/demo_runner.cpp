@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
+#include <system_error>
 #include <vector>
 
 #include "rheofeed/scene/calibration.hpp"
@@ -72,6 +73,23 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
     if (!scene_file.empty()) scene = loadScene(scene_file);
     if (out_dir.empty()) {
       throw std::invalid_argument("--out \"\": must name an output folder (not empty)");
+    }
+    // The output folder is made (or found writable) now, not after a run of minutes or hours.
+    {
+      std::error_code ec;
+      std::filesystem::create_directories(out_dir, ec);
+      if (ec || !std::filesystem::is_directory(out_dir)) {
+        throw std::invalid_argument(
+            "--out " + out_dir + ": cannot create the output folder (" +
+            (ec ? ec.message() : std::string("exists and is not a folder")) + ")");
+      }
+      const std::filesystem::path probe = std::filesystem::path(out_dir) / ".rheofeed_write_test";
+      std::FILE* f = std::fopen(probe.string().c_str(), "w");
+      if (!f) {
+        throw std::invalid_argument("--out " + out_dir + ": the output folder is not writable");
+      }
+      std::fclose(f);
+      std::filesystem::remove(probe, ec);
     }
     const bool dt_given = dt_option->count() > 0;
     if (dt_given && (!(dt > 0) || !std::isfinite(dt))) {

@@ -273,6 +273,18 @@ TEST(SceneCheck, SpawnInsideAFixtureAndBelowTheRemovalHeightFire) {
   EXPECT_EQ(r[0].value, 0.006);
 }
 
+TEST(SceneCheck, RestitutionNearOneIsNamed) {
+  Scene s = beltScene();
+  s.material.restitution = 1.0;
+  const std::vector<Hazard> all = checkScene(s, Method::OdeRheonomic);
+  const std::vector<Hazard> r = ofKind(all, Hazard::Kind::HighRestitution);
+  ASSERT_EQ(r.size(), 1u) << formatHazards(all);
+  EXPECT_EQ(r[0].value, 1.0);
+  EXPECT_EQ(r[0].where, "material.restitution");
+  s.material.restitution = 0.5;
+  EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::HighRestitution).empty());
+}
+
 TEST(SceneCheck, FormatNamesKindPathAndSafeSetting) {
   Hazard h;
   h.kind = Hazard::Kind::Tunnelling;
