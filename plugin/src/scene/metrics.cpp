@@ -268,7 +268,8 @@ std::string healthSummary(const RunHealth& h, int parts) {
     separator = "; ";
   }
   if (h.parts_sunk > 0) {
-    s << separator << h.parts_sunk << " parts sank into a fixture by more than half their size "
+    s << separator << h.parts_sunk << (h.parts_sunk == 1 ? " part" : " parts")
+      << " sank into a fixture by more than half their size "
       << "and came back";
     separator = "; ";
   }
