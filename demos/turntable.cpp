@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "common/demo_runner.hpp"
+#include "rheofeed/scene/builtin_scenes.hpp"
 
 namespace {
 
@@ -17,7 +18,6 @@ using namespace rheofeed;
 using namespace rheofeed::scene;
 
 Scene turntable() {
-  constexpr double kPi = 3.14159265358979323846;
   constexpr double kRadius = 0.4, kOmega = 1.0;  // m, rad/s
   Scene s;
   s.name = "turntable";
@@ -33,18 +33,8 @@ Scene turntable() {
   disc.law.drift.angular = {0, 0, kOmega};
   s.fixtures.push_back(disc);
 
-  Fixture rim;  // 36 static boxes around the disc
-  rim.name = "rim";
-  for (int i = 0; i < 36; ++i) {
-    const double a = 2 * kPi * i / 36;
-    Fixture::Geom b;
-    b.shape.kind = Shape::Kind::Box;
-    b.shape.size = {0.02, 2 * (kRadius + 0.01) * std::tan(kPi / 36) + 0.005, 0.06};
-    b.pose = Pose::axisAngle(
-        {0, 0, 1}, a, {(kRadius + 0.02) * std::cos(a), (kRadius + 0.02) * std::sin(a), 0.02});
-    rim.geoms.push_back(b);
-  }
-  s.fixtures.push_back(rim);
+  // 36 static boxes around the disc, 2 cm thick and 6 cm tall, 1 cm clear of its edge.
+  s.fixtures.push_back(boxRing("rim", 36, kRadius + 0.02, kRadius + 0.01, 0.02, 0.06, 0.02));
 
   Fixture fence;  // a static bar across the disc along the +y axis, just above the surface
   fence.name = "fence";

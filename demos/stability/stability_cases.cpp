@@ -10,6 +10,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "rheofeed/scene/builtin_scenes.hpp"
 #include "rheofeed/scene/calibration.hpp"
 #include "rheofeed/scene/classical_model.hpp"
 
@@ -100,18 +101,7 @@ class Builder {
   /// A static rim of 36 boxes (2 cm thick, 6 cm tall, bottom 1 cm under the table top) around
   /// a table of `radius` (m).
   void rim(double radius) {
-    Fixture rim;
-    rim.name = "rim";
-    for (int i = 0; i < 36; ++i) {
-      const double a = 2 * kPi * i / 36;
-      Fixture::Geom b;
-      b.shape.kind = Shape::Kind::Box;
-      b.shape.size = {0.02, 2 * (radius + 0.01) * std::tan(kPi / 36) + 0.005, 0.06};
-      b.pose = Pose::axisAngle(
-          {0, 0, 1}, a, {(radius + 0.01) * std::cos(a), (radius + 0.01) * std::sin(a), 0.02});
-      rim.geoms.push_back(b);
-    }
-    c_.scene.fixtures.push_back(rim);
+    c_.scene.fixtures.push_back(boxRing("rim", 36, radius + 0.01, radius + 0.01, 0.02, 0.06, 0.02));
   }
   /// A vibrating track along +x: floor lx x ly, 5 cm thick, vibrating at `frequency` (Hz) along
   /// (cos beta, 0, sin beta) with the amplitude of throw number `gamma`; an end wall at

@@ -19,6 +19,27 @@ Fixture boxFixture(const std::string& name, const Vec3& size, const Pose& pose) 
   return f;
 }
 
+}  // namespace
+
+Fixture boxRing(const std::string& name, int count, double centre_radius, double inner_radius,
+                double thickness, double height, double z_centre) {
+  constexpr double kOverlap = 0.005;  // m, between neighbouring boxes
+  Fixture ring;
+  ring.name = name;
+  for (int i = 0; i < count; ++i) {
+    const double a = 2 * kPi * i / count;
+    Fixture::Geom b;
+    b.shape.kind = Shape::Kind::Box;
+    b.shape.size = {thickness, 2 * inner_radius * std::tan(kPi / count) + kOverlap, height};
+    b.pose = Pose::axisAngle({0, 0, 1}, a,
+                             {centre_radius * std::cos(a), centre_radius * std::sin(a), z_centre});
+    ring.geoms.push_back(b);
+  }
+  return ring;
+}
+
+namespace {
+
 PartSpec cube(double edge, const Vec3& at) {
   PartSpec p;
   p.shape = Shape::Kind::Box;

@@ -51,4 +51,11 @@ Scene linearTroughScene(int count = 60, double rate = 20, double amplitude = 0.2
 /// lying flat in one layer spread over its first 0.5 m, touching now and then.
 Scene troughScene(int count = 40, bool heap = false);
 
+/// A static ring of `count` upright boxes about the world z axis (a turntable's rim): box centres
+/// on a circle of radius `centre_radius` (m) at height `z_centre` (m), each `thickness` (m)
+/// radially and `height` (m) tall, and wide enough tangentially to close the ring at
+/// `inner_radius` (m) with 5 mm of overlap between neighbours.
+Fixture boxRing(const std::string& name, int count, double centre_radius, double inner_radius,
+                double thickness, double height, double z_centre);
+
 }  // namespace rheofeed::scene
