@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "rheofeed/scene/mesh.hpp"
+#include "simulation_internal.hpp"
 
 namespace rheofeed::scene {
 namespace {
@@ -112,54 +113,16 @@ struct Box3 {
   }
 };
 
+// Bounding box of a fixture geom at its pose (the scene limits' computation); a plane or a mesh
+// not loaded is unbounded.
 Box3 geomBounds(const Fixture::Geom& g) {
+  const Bounds bounds = fixtureGeomBounds(g);
   Box3 b;
-  const Shape& s = g.shape;
-  const double* r = g.pose.rotation;
-  auto rounded = [&](double half_length, double radius, double cap) {
-    // Segment along local z of half length `half_length`, swept by a disc (cylinder, cap = 0)
-    // or a ball (capsule, cap = 1) of radius `radius`.
-    Vec3 half;
-    for (int i = 0; i < 3; ++i) {
-      const double az = std::abs(r[3 * i + 2]);
-      const double disc = radius * std::sqrt(std::max(0.0, 1 - az * az));
-      const double e = half_length * az + (cap > 0 ? radius : disc);
-      (i == 0 ? half.x : (i == 1 ? half.y : half.z)) = e;
-    }
-    b.add(g.pose.position - half);
-    b.add(g.pose.position + half);
-  };
-  switch (s.kind) {
-    case Shape::Kind::Box:
-      for (int c = 0; c < 8; ++c) {
-        const Vec3 local{(c & 1 ? 0.5 : -0.5) * s.size.x, (c & 2 ? 0.5 : -0.5) * s.size.y,
-                         (c & 4 ? 0.5 : -0.5) * s.size.z};
-        b.add(g.pose.transform(local));
-      }
-      break;
-    case Shape::Kind::Sphere:
-      b.add(g.pose.position - Vec3{s.radius, s.radius, s.radius});
-      b.add(g.pose.position + Vec3{s.radius, s.radius, s.radius});
-      break;
-    case Shape::Kind::Cylinder:
-      rounded(0.5 * s.length, s.radius, 0);
-      break;
-    case Shape::Kind::Capsule:
-      rounded(0.5 * s.length, s.radius, 1);
-      break;
-    case Shape::Kind::Plane:
-      b.bounded = false;
-      break;
-    case Shape::Kind::Mesh:
-      if (s.mesh_data) {
-        const std::vector<double>& v = s.mesh_data->vertices;
-        for (std::size_t k = 0; k + 2 < v.size(); k += 3) {
-          b.add(g.pose.transform({v[k], v[k + 1], v[k + 2]}));
-        }
-      } else {
-        b.bounded = false;
-      }
-      break;
+  if (bounds.min.x > bounds.max.x) {
+    b.bounded = false;
+  } else {
+    b.add(bounds.min);
+    b.add(bounds.max);
   }
   return b;
 }

@@ -197,6 +197,10 @@ std::string formatPosition(const Vec3& x) {
 
 }  // namespace
 
+Bounds fixtureGeomBounds(const Fixture::Geom& g) {
+  return geomBounds(g);
+}
+
 SceneLimits sceneLimits(const Scene& scene) {
   SceneLimits l;
   l.removal_height = scene.removal_height;

@@ -102,6 +102,10 @@ class PartSimulation : public Simulation {
   ContactTotals totals_;
 };
 
+/// Axis-aligned bounding box (m, world) of a fixture geom at its pose; empty (min > max) for a
+/// plane or a mesh that is not loaded. Shared by the scene limits and the scene check.
+Bounds fixtureGeomBounds(const Fixture::Geom& g);
+
 std::unique_ptr<Simulation> makeOdeSimulation(const Scene& scene, Method method);
 std::unique_ptr<Simulation> makeReferenceSimulation(const Scene& scene, Method method);
 
