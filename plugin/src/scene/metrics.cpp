@@ -283,6 +283,16 @@ std::string healthSummary(const RunHealth& h, int parts) {
       << " steps with an unconverged contact solve";
     separator = "; ";
   }
+  if (h.friction_dropped_contacts > 0) {
+    s << separator << h.friction_dropped_contacts
+      << " contact friction impulses dropped by the Coulomb fallback";
+    separator = "; ";
+  }
+  if (h.gyroscopic_fallback_steps > 0) {
+    s << separator << h.gyroscopic_fallback_steps
+      << " steps with a dissipative gyroscopic fallback";
+    separator = "; ";
+  }
   if (!h.ignored_settings.empty()) {
     s << separator << h.ignored_settings.size() << " ignored setting"
       << (h.ignored_settings.size() > 1 ? "s" : "") << " (";
@@ -328,7 +338,7 @@ std::string summaryJson(const RunMetrics& r) {
                 r.mean_drift_ci95, r.vertical_displacement, r.throughput, r.cpu_seconds,
                 r.simulated_seconds, r.real_time_factor);
   const RunHealth& h = r.health;
-  char c[768];
+  char c[1536];
   std::snprintf(c, sizeof c,
                 ", \"health\": {\"steps\": %ld, \"parts_exited\": %d, \"parts_lost\": %d, "
                 "\"parts_fell\": %d, \"parts_through_fixture\": %d, \"parts_out_of_bounds\": %d, "
@@ -336,12 +346,14 @@ std::string summaryJson(const RunMetrics& r) {
                 "\"parts_sunk\": %d, "
                 "\"coulomb_fallback_steps\": %ld, "
                 "\"coulomb_fallback_share\": %.6g, \"solver_unconverged_steps\": %ld, "
+                "\"friction_dropped_contacts\": %ld, \"gyroscopic_fallback_steps\": %ld, "
                 "\"max_part_speed_mps\": %.6g, \"speed_bound_mps\": %.6g, \"ignored_settings\": [",
                 h.steps, h.parts_exited, h.partsLost(), h.parts_fell, h.parts_through_fixture,
                 h.parts_out_of_bounds, h.parts_nonfinite, h.parts_too_fast, h.parts_inside_fixture,
                 h.parts_sunk, h.coulomb_fallback_steps,
                 h.steps > 0 ? double(h.coulomb_fallback_steps) / h.steps : 0.0,
-                h.solver_unconverged_steps, h.max_part_speed, h.speed_bound);
+                h.solver_unconverged_steps, h.friction_dropped_contacts,
+                h.gyroscopic_fallback_steps, h.max_part_speed, h.speed_bound);
   std::string json = "{\"scene\": " + quoted(r.scene) + b + c;
   for (std::size_t k = 0; k < h.ignored_settings.size(); ++k) {
     json += (k ? ", " : "") + quoted(h.ignored_settings[k]);

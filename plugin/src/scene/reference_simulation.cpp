@@ -56,6 +56,27 @@ class ReferenceSimulation final : public PartSimulation {
   // Counts the steps whose contact solve cannot be trusted fully (RunHealth).
   void advance(double h) override {
     const reference::StepReport report = world_->step(h);
+    // Bodies the world found non-finite are disabled there at their last finite pose: counted
+    // here as non-finite parts (their parked state alone would look fine).
+    for (const BodyId body : report.nonfinite_bodies) {
+      const auto it = std::find(parts_.begin(), parts_.end(), body);
+      if (it != parts_.end()) markNonFinite(static_cast<int>(it - parts_.begin()));
+    }
+    if (report.solve.friction_dropped_contacts > 0) {
+      health_.friction_dropped_contacts += report.solve.friction_dropped_contacts;
+      std::ostringstream line;
+      line << "step from t = " << time() << " s: the Coulomb fallback dropped the friction of "
+           << report.solve.friction_dropped_contacts << " contacts to settle its normal impulses";
+      reportFirst("friction dropped", line.str());
+    }
+    if (report.gyroscopic_fallbacks > 0) {
+      ++health_.gyroscopic_fallback_steps;
+      std::ostringstream line;
+      line << "step from t = " << time() << " s: the implicit gyroscopic solve of "
+           << report.gyroscopic_fallbacks
+           << " bodies did not converge (h |w| far beyond 1); they took a dissipative step";
+      reportFirst("gyroscopic fallback", line.str());
+    }
     if (report.coulomb_fallback) {
       ++health_.coulomb_fallback_steps;
       std::ostringstream line;

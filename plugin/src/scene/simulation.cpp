@@ -197,6 +197,10 @@ std::string formatPosition(const Vec3& x) {
 
 }  // namespace
 
+void PartSimulation::markNonFinite(int index) {
+  tracks_.at(static_cast<std::size_t>(index)).engine_nonfinite = true;
+}
+
 Bounds fixtureGeomBounds(const Fixture::Geom& g) {
   return geomBounds(g);
 }
@@ -497,7 +501,8 @@ void PartSimulation::step() {
     Track& tr = tracks_[i];
     if (!tr.active) continue;
     const PartState s = partState(static_cast<int>(i));
-    const PartCheck check = checkPartState(s, limits_, tr.radius);
+    const PartCheck check =
+        tr.engine_nonfinite ? PartCheck::NonFinite : checkPartState(s, limits_, tr.radius);
     if (check == PartCheck::NonFinite) {  // parked at its last finite state
       remove(i, check, s, tr.last);
       continue;

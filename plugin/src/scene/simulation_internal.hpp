@@ -53,6 +53,9 @@ class PartSimulation : public Simulation {
   void ignoreSetting(const std::string& message);
   /// Prints one line on stderr the first time `kind` (a short name) is seen in this run.
   void reportFirst(const std::string& kind, const std::string& line);
+  /// The engine found part `index` non-finite and took it out itself (the reference world
+  /// disables such a body at its last finite pose): the next check counts it as non-finite.
+  void markNonFinite(int index);
 
   const Scene scene_;
   RunHealth health_;
@@ -63,9 +66,10 @@ class PartSimulation : public Simulation {
     double min_half_size = 0;  // smallest half-size of the part (m)
     double radius = 0;         // bounding radius about the centre of mass (m)
     bool active = true;
-    bool beyond_exit = false;   // has been beyond the exit plane
-    bool counted = false;       // counted in a RunHealth loss (or as an exit) already
-    bool sunk_counted = false;  // counted in parts_sunk already
+    bool engine_nonfinite = false;  // the engine reported the state non-finite (markNonFinite)
+    bool beyond_exit = false;       // has been beyond the exit plane
+    bool counted = false;           // counted in a RunHealth loss (or as an exit) already
+    bool sunk_counted = false;      // counted in parts_sunk already
     // Centre inside a fixture: where it entered (m) and the entry surface's outward normal.
     bool inside = false;
     Vec3 entry_point, entry_normal;

@@ -75,6 +75,11 @@ struct RunHealth {
   /// (iteration limit or numerical issue; 0 for ODE, which reports no convergence).
   long coulomb_fallback_steps = 0;
   long solver_unconverged_steps = 0;
+  /// Reference engine: contacts whose friction the Coulomb fallback had to drop to end its
+  /// normal re-solve (StepReport's solve.friction_dropped_contacts), and steps in which a
+  /// body's implicit gyroscopic solve did not converge and took a dissipative step instead.
+  long friction_dropped_contacts = 0;
+  long gyroscopic_fallback_steps = 0;
   /// Settings of the scene this engine does not use although they differ from the
   /// SolverSettings / Material defaults (e.g. "solver.coulomb_iterations = 3: ignored by
   /// ode_rheonomic (...)"), listed and printed once when the simulation is built.
@@ -93,7 +98,8 @@ struct RunHealth {
   /// Whether anything was lost, not trusted or ignored.
   bool anything() const {
     return partsLost() > 0 || parts_sunk > 0 || coulomb_fallback_steps > 0 ||
-           solver_unconverged_steps > 0 || !ignored_settings.empty();
+           solver_unconverged_steps > 0 || friction_dropped_contacts > 0 ||
+           gyroscopic_fallback_steps > 0 || !ignored_settings.empty();
   }
 };
 
