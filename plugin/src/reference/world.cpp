@@ -251,23 +251,22 @@ struct World::Impl {
   }
 
   void collidePair(dGeomID o1, dGeomID o2) {
-    Impl* self = this;
     if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) {
-      dSpaceCollide2(o1, o2, self, &nearCallback);
+      dSpaceCollide2(o1, o2, this, &nearCallback);
       return;
     }
-    const BodyId a = self->bodyOf(o1), b = self->bodyOf(o2);
-    if (!self->isDynamic(a) && !self->isDynamic(b)) return;
+    const BodyId a = bodyOf(o1), b = bodyOf(o2);
+    if (!isDynamic(a) && !isDynamic(b)) return;
     if (a == b) return;
-    const int max = self->settings.max_contacts_per_pair;
-    self->scratch.resize(static_cast<std::size_t>(max));
-    const int n = dCollide(o1, o2, max, self->scratch.data(), sizeof(dContactGeom));
+    const int max = settings.max_contacts_per_pair;
+    scratch.resize(static_cast<std::size_t>(max));
+    const int n = dCollide(o1, o2, max, scratch.data(), sizeof(dContactGeom));
     if (n <= 0) return;
-    const double mu = self->friction ? self->friction(o1, o2) : self->settings.default_mu;
+    const double mu = friction ? friction(o1, o2) : settings.default_mu;
     for (int i = 0; i < n; ++i) {
-      const dContactGeom& c = self->scratch[static_cast<std::size_t>(i)];
-      self->raw.push_back({c.g1, c.g2, self->bodyOf(c.g1), self->bodyOf(c.g2),
-                           toEigen(toVec3(c.pos)), toEigen(toVec3(c.normal)), c.depth, mu, i});
+      const dContactGeom& c = scratch[static_cast<std::size_t>(i)];
+      raw.push_back({c.g1, c.g2, bodyOf(c.g1), bodyOf(c.g2), toEigen(toVec3(c.pos)),
+                     toEigen(toVec3(c.normal)), c.depth, mu, i});
     }
   }
 
