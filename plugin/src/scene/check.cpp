@@ -25,69 +25,6 @@ constexpr double kSeamTolerance = 1e-6;
 // A box edge counts as upright when its direction is within this of the up direction (cosine).
 constexpr double kUprightCosine = 1 - 1e-9;
 
-// ---------------------------------------------------------------------------------------------
-// Mass-ratio limits, measured. A light cube on a floor box (top z = 0), a heavy cube of the same
-// edge e dropped on it from 0.8 e above, densities 1000 and 1000 R kg/m^3, mu 0.5, the scene
-// layer's defaults (ERP 0.2, CFM 1e-5, max correcting velocity 0.5 m/s, no surface layer), run
-// 2 s; the stack holds if the larger of (light into floor, heavy into light) stays below e / 4
-// during the second second (it either stays below 1.5 mm or the heavy part passes the light
-// one completely). The step h is chosen to give X = e / (g h^2), the light part's thickness in
-// units of the distance gravity moves it in one step; X, not e or h alone, sets the boundary
-// (within a factor of 2 for e = 2, 10 and 50 mm). Entries: the largest ratio R on the grid
-// 1, 1.5, 2, 3, 5, 7, 10, 15, 20, 30, 50, ... that held; the minimum over the edges measured
-// (2, 10, 50 mm for X = 5, 20, 100, 500; 10 mm elsewhere). Below X = 20 the probe's drop
-// itself moves the heavy part by 0.5-0.8 thicknesses in its landing step, so the X = 5 and 10
-// rows are lower bounds; equal 2 mm cubes were crushed at X = 5 (k = 100), so below X = 10 the
-// check warns for any stack. Below X = 5 (not measured) it warns for any ratio above 1.
-// Measured with the throwaway probe of check_test.cpp's comment (MassRatioProbe), ODE 0.16:
-//   rheofeed_scene_tests --gtest_also_run_disabled_tests --gtest_filter='*MassRatioProbe*'
-// Quickstep shuffles its constraint rows with ODE's global random generator, so the boundary
-// moves from run to run: a repeat of X = 20, k = 20 crushed a stack at R = 7, the table's entry.
-// The limit used is the table's times this margin.
-constexpr double kRandomOrderMargin = 0.5;
-constexpr double kRatioX[] = {5, 10, 20, 50, 100, 200, 500, 2000, 8000};
-constexpr int kOdeIterations[] = {10, 20, 50, 100, 200};
-constexpr double kOdeHolds[9][5] = {
-    {3, 1, 2, 0, 5},              // X = 5 (drop-affected; 0: equal 2 mm cubes crushed)
-    {3, 7, 15, 30, 70},           // X = 10 (10 mm only; drop-affected)
-    {7, 7, 15, 30, 100},          // X = 20
-    {10, 20, 30, 70, 200},        // X = 50 (10 mm only)
-    {20, 20, 30, 70, 300},        // X = 100
-    {30, 50, 70, 150, 300},       // X = 200 (10 mm only)
-    {50, 50, 100, 300, 700},      // X = 500
-    {100, 200, 300, 1000, 2000},  // X = 2000 (10 mm only)
-    {300, 500, 1500, 2000, 3000}  // X = 8000 (10 mm only)
-};
-// The reference solver (APGD, tolerance 1e-6 on the scale-invariant residual of solver.hpp, 10
-// Coulomb iterations with the fallback that re-solves the normal impulses), 10 mm cubes, X = 20,
-// 100, 500 only, re-measured after those changes (the earlier table, with an absolute
-// tolerance, held up to 10 times more at some points). It holds 3-10 times the ratio of ODE
-// quickstep at the same iteration count; the X = 500, k = 20 entry is below X = 100's (not
-// monotone; tableLimit takes the minimum over the points at or above).
-constexpr double kRefX[] = {20, 100, 500};
-constexpr int kRefIterations[] = {20, 50, 100};
-constexpr double kRefHolds[3][3] = {
-    {50, 200, 700},    // X = 20
-    {200, 300, 1000},  // X = 100
-    {150, 700, 1500},  // X = 500
-};
-
-// The measured limit at the grid point at or below (X, k), taken as the minimum over every grid
-// point at or above it, so that a non-monotone measurement never raises the limit.
-template <std::size_t NX, std::size_t NK>
-double tableLimit(const double (&xs)[NX], const int (&ks)[NK], const double (&holds)[NX][NK],
-                  double x, int k) {
-  if (!(x >= xs[0]) || k < ks[0]) return 1;  // below the grid: any ratio above 1 warns
-  std::size_t i0 = 0, j0 = 0;
-  while (i0 + 1 < NX && xs[i0 + 1] <= x) ++i0;
-  while (j0 + 1 < NK && ks[j0 + 1] <= k) ++j0;
-  double limit = kInf;
-  for (std::size_t i = i0; i < NX; ++i) {
-    for (std::size_t j = j0; j < NK; ++j) limit = std::min(limit, holds[i][j]);
-  }
-  return limit;
-}
-
 std::string fmt(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3g", v);
@@ -422,16 +359,6 @@ const char* toString(Hazard::Kind kind) {
       return "ignored_setting";
   }
   return "unknown";
-}
-
-double odeQuickstepMassRatioLimit(int iterations, double thickness, double time_step, double g) {
-  return kRandomOrderMargin * tableLimit(kRatioX, kOdeIterations, kOdeHolds,
-                                         thickness / (g * time_step * time_step), iterations);
-}
-
-double referenceMassRatioLimit(int iterations, double thickness, double time_step, double g) {
-  return tableLimit(kRefX, kRefIterations, kRefHolds, thickness / (g * time_step * time_step),
-                    iterations);
 }
 
 std::vector<Hazard> checkScene(const Scene& scene, Method method) {
