@@ -1,0 +1,440 @@
+// SPDX-License-Identifier: MIT
+#include "rheofeed/vibration_drift.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
+#include <vector>
+
+namespace rheofeed {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Grid steps of LocalDriftTable (header).
+constexpr double kThrowStep = 0.025;
+constexpr double kTangentialThrowStep = 0.05;
+constexpr double kSlopeStep = 0.01;
+
+// The relative state of the mass at the start of a cycle (units: velocities |g_n| / w, gap
+// |g_n| / w^2).
+struct CycleState {
+  double u1 = 0, u2 = 0, vn = 0, gap = 0;
+};
+
+struct CycleResult {
+  double d1 = 0, d2 = 0;         // in-plane displacement over the cycle (units |g_n| / w^2)
+  double flight = 0, stick = 0;  // fractions of the cycle
+};
+
+// One resolution of the model: Moreau steps of h = 2 pi / n in w t.
+class MoreauPointMass {
+ public:
+  MoreauPointMass(const PointMassParams& p, int steps) : p_(p), steps_(steps) {
+    h_ = 2 * kPi / steps;
+    sin_mid_.resize(static_cast<std::size_t>(steps));
+    // The mean of sin over each step: the free velocity change over the step is then exact.
+    for (int k = 0; k < steps; ++k) {
+      sin_mid_[static_cast<std::size_t>(k)] = (std::cos(k * h_) - std::cos((k + 1) * h_)) / h_;
+    }
+  }
+
+  // Advances one cycle from `s` (updated in place).
+  CycleResult cycle(CycleState& s) const {
+    CycleResult r;
+    const double h = h_, mu = p_.mu;
+    int flying = 0, sticking = 0;
+    for (int k = 0; k < steps_; ++k) {
+      const double sn = sin_mid_[static_cast<std::size_t>(k)];
+      // Free velocities after the step (relative acceleration g + a w^2 sin(w t), per |g_n|).
+      double u1 = s.u1 + h * (p_.slope_along + p_.tangential_throw * sn);
+      double u2 = s.u2 + h * p_.slope_across;
+      double vn = s.vn + h * (-1.0 + p_.normal_throw * sn);
+      const bool closed = s.gap + 0.5 * h * s.vn <= 0;  // the gap at mid-step (Moreau)
+      if (closed && vn <= 0) {
+        const double impulse = -vn;  // plastic: the normal velocity is killed
+        vn = 0;
+        s.gap = 0;
+        const double slip = std::sqrt(u1 * u1 + u2 * u2);
+        const double limit = mu * impulse;
+        if (slip <= limit) {  // the Coulomb disc holds it
+          u1 = 0;
+          u2 = 0;
+          ++sticking;
+        } else {
+          const double keep = 1.0 - limit / slip;
+          u1 *= keep;
+          u2 *= keep;
+        }
+      } else {
+        s.gap += h * vn;
+        ++flying;
+      }
+      s.u1 = u1;
+      s.u2 = u2;
+      s.vn = vn;
+      r.d1 += h * u1;
+      r.d2 += h * u2;
+    }
+    r.flight = double(flying) / steps_;
+    r.stick = double(sticking) / steps_;
+    return r;
+  }
+
+ private:
+  PointMassParams p_;
+  int steps_;
+  double h_;
+  std::vector<double> sin_mid_;
+};
+
+bool sameState(const CycleState& a, const CycleState& b, double tol) {
+  return std::fabs(a.u1 - b.u1) <= tol && std::fabs(a.u2 - b.u2) <= tol &&
+         std::fabs(a.vn - b.vn) <= tol && std::fabs(a.gap - b.gap) <= tol;
+}
+
+// The steady state at one resolution.
+PointMassDrift steadyState(const PointMassParams& p, const PointMassSettings& settings, int steps) {
+  const MoreauPointMass model(p, steps);
+  std::vector<CycleState> starts;
+  std::vector<CycleResult> cycles;
+  starts.reserve(static_cast<std::size_t>(settings.max_cycles) + 1);
+  cycles.reserve(static_cast<std::size_t>(settings.max_cycles));
+  CycleState s;
+  starts.push_back(s);
+  int period = 0;
+  for (int c = 0; c < settings.max_cycles && period == 0; ++c) {
+    cycles.push_back(model.cycle(s));
+    starts.push_back(s);
+    const int n = static_cast<int>(starts.size()) - 1;  // index of the newest start
+    for (int q = 1; q <= settings.max_period && q <= n - 1; ++q) {
+      // Steady once the newest start equals the one q cycles before, and that one the one
+      // before it (two repetitions, so a transient passing near an old state is not taken).
+      if (sameState(starts[static_cast<std::size_t>(n)], starts[static_cast<std::size_t>(n - q)],
+                    settings.periodic_tolerance) &&
+          (n - 2 * q < 0 ||
+           sameState(starts[static_cast<std::size_t>(n - q)],
+                     starts[static_cast<std::size_t>(n - 2 * q)], settings.periodic_tolerance))) {
+        period = q;
+        break;
+      }
+    }
+  }
+  const int count =
+      period > 0 ? period : std::min(settings.average_cycles, static_cast<int>(cycles.size()));
+  PointMassDrift d;
+  d.period = period;
+  double d1 = 0, d2 = 0, flight = 0, stick = 0;
+  for (std::size_t i = cycles.size() - static_cast<std::size_t>(count); i < cycles.size(); ++i) {
+    d1 += cycles[i].d1;
+    d2 += cycles[i].d2;
+    flight += cycles[i].flight;
+    stick += cycles[i].stick;
+  }
+  d.along = d1 / (2 * kPi * count);
+  d.across = d2 / (2 * kPi * count);
+  d.flight_fraction = flight / count;
+  d.stick_fraction = stick / count;
+  d.valid = true;
+  return d;
+}
+
+std::string paramsProblem(const PointMassParams& p, const PointMassSettings& settings) {
+  std::ostringstream out;
+  const double slope = std::hypot(p.slope_along, p.slope_across);
+  if (!std::isfinite(p.normal_throw) || p.normal_throw < 0) {
+    out << "normal throw number = " << p.normal_throw << ": must be finite and >= 0";
+  } else if (!std::isfinite(p.tangential_throw) || p.tangential_throw < 0) {
+    out << "tangential throw number = " << p.tangential_throw << ": must be finite and >= 0";
+  } else if (!std::isfinite(p.slope_along) || !std::isfinite(p.slope_across)) {
+    out << "slope (" << p.slope_along << ", " << p.slope_across << ") is not finite";
+  } else if (!std::isfinite(p.mu) || p.mu < 0) {
+    out << "mu = " << p.mu << ": must be finite and >= 0";
+  } else if (slope > 0 && !(slope < p.mu)) {
+    out << "slope tangent " << slope << " >= mu = " << p.mu
+        << ": the mass slides away with or without vibration, no steady drift";
+  } else if (settings.steps_per_cycle < 16 || settings.steps_per_cycle % 2 != 0 ||
+             settings.max_cycles < 8 || settings.average_cycles < 1 ||
+             settings.average_cycles > settings.max_cycles || settings.max_period < 1 ||
+             !(settings.periodic_tolerance > 0)) {
+    out << "point-mass settings out of range: steps_per_cycle >= 16 and even, max_cycles >= 8, "
+           "1 <= average_cycles <= max_cycles, max_period >= 1, periodic_tolerance > 0";
+  }
+  return out.str();
+}
+
+}  // namespace
+
+PointMassDrift pointMassDrift(const PointMassParams& params, const PointMassSettings& settings) {
+  PointMassDrift result;
+  result.problem = paramsProblem(params, settings);
+  if (!result.problem.empty()) return result;
+  if (params.mu == 0) {  // frictionless and level: nothing in the plane drives the mass
+    result.valid = true;
+    result.flight_fraction = params.normal_throw > 1 ? 1 : 0;
+    return result;
+  }
+  return steadyState(params, settings, settings.steps_per_cycle);
+}
+
+void LocalVibration::validate(const std::string& where) const {
+  auto fail = [&](const std::string& what) { throw std::invalid_argument(where + ": " + what); };
+  auto finite = [](const Vec3& v) { return isFinite(v); };
+  std::ostringstream out;
+  if (!(frequency > 0 && frequency <= 1e5)) {
+    out << "vibration frequency = " << frequency << " Hz: must be in (0, 1e+05] Hz";
+    fail(out.str());
+  }
+  if (!finite(amplitude) || !(norm(amplitude) <= 1e3)) {
+    out << "vibration |amplitude| = " << norm(amplitude) << " m: must be finite, in [0, 1e+03] m";
+    fail(out.str());
+  }
+  if (!(torsion_amplitude >= 0 && torsion_amplitude <= kPi)) {
+    out << "torsion amplitude = " << torsion_amplitude << " rad: must be in [0, pi] rad";
+    fail(out.str());
+  }
+  if (!finite(axis_origin) || !finite(axis_direction) ||
+      !(std::fabs(norm(axis_direction) - 1) <= 1e-6)) {
+    out << "torsion axis (origin (" << axis_origin.x << ", " << axis_origin.y << ", "
+        << axis_origin.z << ") m, direction |k| = " << norm(axis_direction)
+        << "): must be finite with a unit direction";
+    fail(out.str());
+  }
+  if (!finite(gravity) || !(norm(gravity) > 0)) {
+    out << "gravity |g| = " << norm(gravity) << " m/s^2: must be finite and > 0";
+    fail(out.str());
+  }
+  if (!(efficiency >= 0 && efficiency <= 100)) {
+    out << "efficiency = " << efficiency << ": must be in [0, 100]";
+    fail(out.str());
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The table.
+
+namespace {
+
+struct CornerKey {
+  std::int64_t i[4];
+  std::uint64_t mu;
+  bool operator==(const CornerKey& o) const {
+    return i[0] == o.i[0] && i[1] == o.i[1] && i[2] == o.i[2] && i[3] == o.i[3] && mu == o.mu;
+  }
+};
+
+struct CornerKeyHash {
+  std::size_t operator()(const CornerKey& k) const {
+    std::uint64_t h = k.mu * 0x9E3779B97F4A7C15ull;
+    for (std::int64_t v : k.i) h = (h ^ static_cast<std::uint64_t>(v)) * 0x100000001B3ull;
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+};
+
+std::uint64_t bitsOf(double x) {
+  std::uint64_t b;
+  std::memcpy(&b, &x, sizeof b);
+  return b;
+}
+
+struct Corner {
+  double v1 = 0, v2 = 0;
+  bool valid = false;
+};
+
+struct Cell {
+  std::array<Corner, 16> corners;
+  bool valid = false;  // all corners valid
+};
+
+}  // namespace
+
+struct LocalDriftTable::Impl {
+  PointMassSettings settings;
+  std::mutex mutex;
+  std::unordered_map<CornerKey, Corner, CornerKeyHash> corners;
+  std::unordered_map<CornerKey, Cell, CornerKeyHash> cells;
+  LocalDriftStats stats;
+  bool has_last = false;
+  PointMassParams last_params;
+  PointMassDrift last_result;
+
+  Corner corner(const CornerKey& key, double mu) {
+    auto it = corners.find(key);
+    if (it != corners.end()) return it->second;
+    PointMassParams p;
+    p.normal_throw = key.i[0] * kThrowStep;
+    p.tangential_throw = key.i[1] * kTangentialThrowStep;
+    p.slope_along = key.i[2] * kSlopeStep;
+    p.slope_across = key.i[3] * kSlopeStep;
+    p.mu = mu;
+    const PointMassDrift d = pointMassDrift(p, settings);
+    ++stats.model_runs;
+    Corner c{d.along, d.across, d.valid};
+    corners.emplace(key, c);
+    return c;
+  }
+};
+
+LocalDriftTable::LocalDriftTable(PointMassSettings settings) : impl_(std::make_unique<Impl>()) {
+  impl_->settings = settings;
+}
+LocalDriftTable::~LocalDriftTable() = default;
+
+LocalDriftStats LocalDriftTable::stats() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->stats;
+}
+
+PointMassDrift LocalDriftTable::drift(const PointMassParams& p) {
+  Impl& s = *impl_;
+  std::lock_guard<std::mutex> lock(s.mutex);
+  if (s.has_last && p.normal_throw == s.last_params.normal_throw &&
+      p.tangential_throw == s.last_params.tangential_throw &&
+      p.slope_along == s.last_params.slope_along && p.slope_across == s.last_params.slope_across &&
+      p.mu == s.last_params.mu) {
+    return s.last_result;
+  }
+  PointMassDrift result;
+  const double x[4] = {p.normal_throw / kThrowStep, p.tangential_throw / kTangentialThrowStep,
+                       p.slope_along / kSlopeStep, p.slope_across / kSlopeStep};
+  bool inside = std::isfinite(p.mu) && p.mu >= 0;
+  for (double v : x) inside = inside && std::isfinite(v) && std::fabs(v) < 1e15;
+  if (!inside) {
+    result = pointMassDrift(p, s.settings);  // names the bad input
+  } else {
+    CornerKey key;
+    double frac[4];
+    for (int d = 0; d < 4; ++d) {
+      const double f = std::floor(x[d]);
+      key.i[d] = static_cast<std::int64_t>(f);
+      frac[d] = x[d] - f;
+    }
+    key.mu = bitsOf(p.mu);
+    auto it = s.cells.find(key);
+    if (it == s.cells.end()) {
+      Cell cell;
+      cell.valid = true;
+      for (int c = 0; c < 16; ++c) {
+        CornerKey ck = key;
+        for (int d = 0; d < 4; ++d) ck.i[d] += (c >> d) & 1;
+        cell.corners[static_cast<std::size_t>(c)] = s.corner(ck, p.mu);
+        cell.valid = cell.valid && cell.corners[static_cast<std::size_t>(c)].valid;
+      }
+      ++s.stats.cells_computed;
+      it = s.cells.emplace(key, cell).first;
+    }
+    const Cell& cell = it->second;
+    if (cell.valid) {
+      double v1 = 0, v2 = 0;
+      for (int c = 0; c < 16; ++c) {
+        double w = 1;
+        for (int d = 0; d < 4; ++d) w *= ((c >> d) & 1) ? frac[d] : 1 - frac[d];
+        v1 += w * cell.corners[static_cast<std::size_t>(c)].v1;
+        v2 += w * cell.corners[static_cast<std::size_t>(c)].v2;
+      }
+      result.along = v1;
+      result.across = v2;
+      result.valid = true;
+    } else {  // a corner beyond the friction angle: the point itself may still be inside
+      result = pointMassDrift(p, s.settings);
+      ++s.stats.model_runs;
+    }
+  }
+  s.has_last = true;
+  s.last_params = p;
+  s.last_result = result;
+  return result;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The law at a contact.
+
+namespace {
+
+// A unit vector orthogonal to the unit vector n.
+Vec3 anyPerpendicular(const Vec3& n) {
+  const Vec3 t = std::fabs(n.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  const Vec3 e = tangentialPart(t, n);
+  return (1.0 / norm(e)) * e;
+}
+
+// The point-mass drift on a gravity-loaded plane (g . n < 0, |g_t| < mu |g_n|). `ok` false when
+// the model refused the inputs.
+Vec3 planeDrift(const LocalVibration& v, const Vec3& p, const Vec3& n, double mu,
+                LocalDriftTable* table, bool* ok) {
+  const double w = 2 * kPi * v.frequency;
+  Vec3 a = v.amplitude;
+  if (v.torsion_amplitude != 0) {
+    a = a + v.torsion_amplitude * cross(v.axis_direction, p - v.axis_origin);
+  }
+  double an = dot(a, n);
+  if (an < 0) {  // half a period of phase
+    a = -a;
+    an = -an;
+  }
+  const Vec3 at = a - an * n;
+  const double gn = -dot(v.gravity, n);  // > 0
+  const Vec3 gt = v.gravity + gn * n;
+  const double at_len = norm(at), gt_len = norm(gt);
+  Vec3 e1;
+  if (at_len > 1e-12 * norm(a) && at_len > 0) {
+    e1 = (1.0 / at_len) * at;
+  } else if (gt_len > 0) {
+    e1 = (1.0 / gt_len) * gt;
+  } else {
+    e1 = anyPerpendicular(n);
+  }
+  Vec3 e2 = cross(n, e1);
+  PointMassParams q;
+  q.normal_throw = an * w * w / gn;
+  q.tangential_throw = at_len * w * w / gn;
+  q.slope_along = dot(gt, e1) / gn;
+  q.slope_across = dot(gt, e2) / gn;
+  if (q.slope_across < 0) {  // mirror: only s2 >= 0 is computed
+    q.slope_across = -q.slope_across;
+    e2 = -e2;
+  }
+  q.mu = mu;
+  const PointMassDrift d = table ? table->drift(q) : pointMassDrift(q);
+  *ok = d.valid;
+  if (!d.valid) return {};
+  return (v.efficiency * gn / w) * (d.along * e1 + d.across * e2);
+}
+
+}  // namespace
+
+Vec3 localDrift(const LocalVibration& vibration, const Vec3& p, const Vec3& n_out, double mu,
+                LocalDriftTable* table, bool* wall) {
+  // An infinite mu (ODE's dInfinity) is a surface without slip: 1e3 behaves the same.
+  mu = std::min(mu, 1e3);
+  const double g = norm(vibration.gravity);
+  const double gn = -dot(vibration.gravity, n_out);
+  bool use_wall = !(gn > g * std::cos(kWallAngle));
+  if (!use_wall) {
+    const double gt = norm(tangentialPart(vibration.gravity, n_out));
+    use_wall = !(gt < mu * gn);
+  }
+  Vec3 drift;
+  bool ok = false;
+  if (!use_wall) drift = planeDrift(vibration, p, n_out, mu, table, &ok);
+  if (!ok) {  // walls, overhangs, slopes beyond the friction angle
+    use_wall = true;
+    const Vec3 up = (-1.0 / g) * vibration.gravity;
+    drift = tangentialPart(planeDrift(vibration, p, up, mu, table, &ok), n_out);
+  }
+  if (table) {
+    std::lock_guard<std::mutex> lock(table->impl_->mutex);
+    ++table->impl_->stats.contacts;
+    if (use_wall) ++table->impl_->stats.wall_contacts;
+  }
+  if (wall) *wall = use_wall;
+  return drift;
+}
+
+}  // namespace rheofeed
