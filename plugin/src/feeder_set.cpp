@@ -88,6 +88,13 @@ struct FeederSet::Impl {
   std::function<void(const Diagnostic&)> handler;
   std::uint64_t invalid_calls = 0;
   bool invalid_call_reported = false;
+  std::unordered_map<dBodyID, double> part_efficiency;  // setPartEfficiency
+
+  double partEfficiency(dBodyID body) const {
+    if (part_efficiency.empty() || !body) return 1.0;
+    auto it = part_efficiency.find(body);
+    return it == part_efficiency.end() ? 1.0 : it->second;
+  }
 
   Feeder* find(dGeomID geom) const {
     if (feeders.size() <= kLinearLookupLimit) {
@@ -286,6 +293,20 @@ void FeederSet::remove(dGeomID geom) {
   impl_->by_geom.erase(geom);
 }
 
+void FeederSet::setPartEfficiency(dBodyID body, double factor) {
+  if (!body || !(factor >= 0 && factor <= 100)) {
+    std::ostringstream out;
+    out << "rheofeed::FeederSet::setPartEfficiency: " << (body ? "factor = " : "body is null");
+    if (body) out << factor << " must be in [0, 100]";
+    throw std::invalid_argument(out.str());
+  }
+  impl_->part_efficiency[body] = factor;
+}
+
+void FeederSet::clearPartEfficiency(dBodyID body) {
+  impl_->part_efficiency.erase(body);
+}
+
 bool FeederSet::contains(dGeomID geom) const {
   return geom && impl_->find(geom) != nullptr;
 }
@@ -389,7 +410,16 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
           s.report(*f, law.threw() ? DiagnosticKind::LawThrew : DiagnosticKind::LawNotFinite,
                    [&] { return law.problem() + "; contact left undriven"; });
         } else {
-          value = law.tangentialVelocity(p, n);
+          if (law.needsContactSide()) {
+            // A local vibration law: the normal out of this feeder (ODE's points from g2 into
+            // g1), the contact's mu and the part's own efficiency.
+            const bool feeder_is_g1 = f == f1;
+            const dBodyID part = feeder_is_g1 ? bodyOf(g2) : bodyOf(g1);
+            value =
+                law.contactVelocity(p, feeder_is_g1 ? -n : n, c.surface.mu, s.partEfficiency(part));
+          } else {
+            value = law.tangentialVelocity(p, n);
+          }
           // A secant law carries the body on the other side of the contact rigidly; it is then
           // evaluated again. (Written this way because the if/else and ?: forms made every belt
           // and translation contact ~15 ns slower with GCC 12 -O3, measured.)

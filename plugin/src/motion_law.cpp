@@ -220,6 +220,19 @@ MotionLaw MotionLaw::twistFunction(std::function<Twist(double)> twist_of_time, F
   return law;
 }
 
+MotionLaw MotionLaw::localVibration(const LocalVibration& vibration,
+                                    const PointMassSettings& settings) {
+  MotionLaw law;
+  law.kind_ = Kind::LocalVibration;
+  law.local_ = std::make_shared<const LocalVibration>(vibration);
+  law.table_ = std::make_shared<LocalDriftTable>(settings);
+  return law;
+}
+
+LocalDriftStats MotionLaw::localStats() const {
+  return table_ ? table_->stats() : LocalDriftStats{};
+}
+
 MotionLaw MotionLaw::withProfile(TimeProfile profile) const {
   MotionLaw law = *this;
   law.profile_ = std::move(profile);
@@ -273,6 +286,12 @@ void MotionLaw::validate(const std::string& where) const {
       break;
     case Kind::TwistFunction:
       if (!twist_function_) throw std::invalid_argument(where + ": twist function is empty");
+      break;
+    case Kind::LocalVibration:
+      if (frame_ != Frame::World) {
+        throw std::invalid_argument(where + ": a local vibration law is in the world frame");
+      }
+      local_->validate(where);
       break;
   }
   profile_.validate(where);
@@ -330,6 +349,13 @@ StepLaw MotionLaw::evaluate(double t, const Pose* body_pose, double step) const 
     s.eval_ = s.scale_ == 0.0 ? StepLaw::Eval::Zero : StepLaw::Eval::Field;
     s.field_ = &field_;
     s.time_varying_field_ = field_time_varying_;
+    return s;
+  }
+
+  if (kind_ == Kind::LocalVibration) {
+    s.eval_ = s.scale_ == 0.0 ? StepLaw::Eval::Zero : StepLaw::Eval::Local;
+    s.local_ = local_.get();
+    s.table_ = table_.get();
     return s;
   }
 
@@ -459,8 +485,16 @@ Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n) const {
       if (!isFinite(c)) return c;  // as the field gave it, so a report can name the value
       return scale_ * tangentialPart(c, n);
     }
+    case Eval::Local:
+      return contactVelocity(p, n, local_->mu);
   }
   return {};
+}
+
+Vec3 StepLaw::contactVelocity(const Vec3& p, const Vec3& n_out, double mu,
+                              double efficiency) const {
+  if (eval_ != Eval::Local) return tangentialVelocity(p, n_out);
+  return (scale_ * efficiency) * localDrift(*local_, p, n_out, mu, table_);
 }
 
 Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n, const Vec3& carried) const {
@@ -483,6 +517,8 @@ bool StepLaw::sameMotionAs(const StepLaw& other) const {
       return true;
     case Eval::Field:
       return field_ == other.field_ && scale_ == other.scale_ && !time_varying_field_;
+    case Eval::Local:
+      return local_ == other.local_ && scale_ == other.scale_;
     default:  // a secant also depends on the step length
       return v_ == other.v_ && w_ == other.w_ && o_ == other.o_ && step_ == other.step_;
   }

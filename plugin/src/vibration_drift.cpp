@@ -209,6 +209,10 @@ void LocalVibration::validate(const std::string& where) const {
     out << "gravity |g| = " << norm(gravity) << " m/s^2: must be finite and > 0";
     fail(out.str());
   }
+  if (!(mu >= 0 && mu <= 1e3)) {
+    out << "mu = " << mu << ": must be in [0, 1e+03]";
+    fail(out.str());
+  }
   if (!(efficiency >= 0 && efficiency <= 100)) {
     out << "efficiency = " << efficiency << ": must be in [0, 100]";
     fail(out.str());

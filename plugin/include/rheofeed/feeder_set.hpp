@@ -158,6 +158,14 @@ class FeederSet {
   void setLaw(dGeomID geom, MotionLaw law);
   /// Unregister (throws if unregistered).
   void remove(dGeomID geom);
+  /// The part's own efficiency under local vibration laws (MotionLaw::localVibration): the
+  /// drift on every contact of `body` with such a feeder is multiplied by `factor`
+  /// (dimensionless, in [0, 100]; 1 = the law's point-mass drift times its own efficiency).
+  /// Measured per part family by a sampling run (issue 8). Throws std::invalid_argument naming
+  /// the value if body is null or factor is out of range. Other laws ignore it.
+  void setPartEfficiency(dBodyID body, double factor);
+  /// Forget a body's factor (call when the body is destroyed; unknown bodies are ignored).
+  void clearPartEfficiency(dBodyID body);
   /// Whether `geom` is a registered feeder.
   bool contains(dGeomID geom) const;
   /// The law of a registered feeder (throws if unregistered).

@@ -47,9 +47,11 @@
 
 #include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 
 #include "rheofeed/vec3.hpp"
+#include "rheofeed/vibration_drift.hpp"
 
 namespace rheofeed {
 
@@ -143,6 +145,9 @@ class MotionLaw {
     TwistFunction,  ///< twist given as a user function of time
     Belt,   ///< a belt: speed s along a direction, kept at |s| on any face it is not normal to
     Field,  ///< a user field c(p, n, t)
+    /// A vibrating feeder's local drift (vibration_drift.hpp): at each contact the point-mass
+    /// drift of the feeder's real vibration at that point, for that contact normal and mu.
+    LocalVibration,
   };
 
   /// The default law: a stationary surface (zero twist, world frame).
@@ -167,6 +172,16 @@ class MotionLaw {
   static MotionLaw twistFunction(std::function<Twist(double t)> twist_of_time,
                                  Frame frame = Frame::World);
 
+  /// The local vibration law of a stationary vibrating feeder (world frame; issue 8): at a
+  /// contact at p with the feeder's outward unit normal n and friction mu, c_t is the
+  /// cycle-averaged drift of a point mass on the plane (p, n) vibrating with the feeder's real
+  /// local vibration, times vibration.efficiency (vibration_drift.hpp). Drifts are tabulated
+  /// lazily (LocalDriftTable, shared by the copies of this law). FeederSet passes the contact's
+  /// own mu and the normal turned out of the feeder; the two-argument
+  /// StepLaw::tangentialVelocity takes n as that outward normal and uses vibration.mu.
+  static MotionLaw localVibration(const LocalVibration& vibration,
+                                  const PointMassSettings& settings = {});
+
   /// A copy of this law whose velocities are multiplied by `profile(t)`.
   MotionLaw withProfile(TimeProfile profile) const;
 
@@ -178,6 +193,10 @@ class MotionLaw {
   /// Belt speed (m/s; Belt kind, else 0).
   double beltSpeed() const { return kind_ == Kind::Belt ? belt_speed_ : 0.0; }
   const TimeProfile& profile() const { return profile_; }
+  /// The vibration of a LocalVibration law (nullptr for other kinds).
+  const LocalVibration* localVibration() const { return local_.get(); }
+  /// Contact counts and table size of a LocalVibration law (zeros for other kinds).
+  LocalDriftStats localStats() const;
   /// True if the law's values can change with time (a profile, a twist function, a time-varying
   /// field). Constant laws are evaluated once and cached.
   bool isTimeVarying() const;
@@ -209,6 +228,8 @@ class MotionLaw {
   SurfaceField field_;
   bool field_time_varying_ = false;
   std::function<Twist(double)> twist_function_;
+  std::shared_ptr<const LocalVibration> local_;
+  std::shared_ptr<LocalDriftTable> table_;
   TimeProfile profile_;
 };
 
@@ -234,6 +255,14 @@ class StepLaw {
   /// True if `carried` changes tangentialVelocity (a secant law): callers may skip looking up
   /// the carried body otherwise.
   bool usesCarriedPoint() const { return eval_ == Eval::Secant; }
+  /// True for a local vibration law: its value depends on which side of the contact the
+  /// feeder is and on the contact's mu (contactVelocity).
+  bool needsContactSide() const { return eval_ == Eval::Local; }
+  /// Local vibration law: the drift c_t (m/s, world) at `p` (m, world) where `n_out` is the unit
+  /// normal pointing out of the feeder into the part and `mu` the contact's friction
+  /// coefficient; `efficiency` multiplies it (a part family's own factor, 1 = the law's own).
+  /// Any other law: tangentialVelocity(p, n_out).
+  Vec3 contactVelocity(const Vec3& p, const Vec3& n_out, double mu, double efficiency = 1) const;
 
   /// Whether the frozen values are all finite and within the limits (kMaxSurfaceSpeed, ...; a
   /// profile or twist function can fail, or throw).
@@ -249,7 +278,7 @@ class StepLaw {
 
  private:
   friend class MotionLaw;
-  enum class Eval { Zero, Translation, Twist, Secant, Belt, Field };
+  enum class Eval { Zero, Translation, Twist, Secant, Belt, Field, Local };
   // Turns a Twist (w != 0) into its secant over a step of h > 0 seconds: c = M (p - O) + d.
   void freezeSecant(double h);
   // The (untruncated) secant velocity at p: M (p - O) + d.
@@ -261,6 +290,8 @@ class StepLaw {
   Vec3 d_;             // Secant: c at p = O (m/s, world)
   double step_ = 0.0;  // h (s) of a Secant, else 0
   const SurfaceField* field_ = nullptr;
+  const LocalVibration* local_ = nullptr;  // Local: the law's vibration and table
+  LocalDriftTable* table_ = nullptr;
   double scale_ = 1.0;
   double time_ = 0.0;
   bool time_varying_field_ = false;

@@ -114,9 +114,13 @@ struct LocalVibration {
   /// The part's own efficiency: a factor on the point-mass drift (dimensionless, >= 0; 1 = a
   /// point mass). Measured by a sampling run as sampled drift / local drift (issue 8).
   double efficiency = 1;
+  /// Friction coefficient used where a caller gives no contact mu (the two-argument
+  /// StepLaw::tangentialVelocity); FeederSet and the reference world pass the contact's own.
+  double mu = 0.5;
   /// Throws std::invalid_argument naming the bad value, `where` it came from and the range:
   /// frequency in (0, 1e5] Hz, |amplitude| <= 1e3 m, theta in [0, pi], k unit (|k| within 1e-6
-  /// of 1), gravity finite and non-zero, efficiency in [0, 100], everything finite.
+  /// of 1), gravity finite and non-zero, efficiency in [0, 100], mu in [0, 1e3], everything
+  /// finite.
   void validate(const std::string& where) const;
   /// Whether the local amplitude is the same at every point (no torsion).
   bool isTranslation() const { return torsion_amplitude == 0; }

@@ -142,7 +142,8 @@ struct World::Impl {
     Matrix3d inertia_body = Matrix3d::Zero();
     BodyState state;
     MotionOfTime motion;
-    int dof = -1;  // first generalised velocity index (dynamic bodies only)
+    int dof = -1;           // first generalised velocity index (dynamic bodies only)
+    double efficiency = 1;  // factor on local vibration laws (World::setBodyEfficiency)
     Vector3d force = Vector3d::Zero(), torque = Vector3d::Zero();
   };
   struct Attached {
@@ -270,14 +271,22 @@ struct World::Impl {
     }
   }
 
-  // Tangential surface velocity of geom g at p with normal n (0 if g is no feeder), carrying
-  // the body `carried` on the other side of the contact (StepLaw::tangentialVelocity).
-  Vector3d surfaceVelocity(dGeomID g, const Vector3d& p, const Vector3d& n, BodyId carried) const {
+  // Tangential surface velocity of geom g at p with normal n_out pointing out of g (0 if g is
+  // no feeder), friction mu, carrying the body `carried` on the other side of the contact
+  // (StepLaw::tangentialVelocity; a local vibration law uses n_out, mu and the body's
+  // efficiency: StepLaw::contactVelocity).
+  Vector3d surfaceVelocity(dGeomID g, const Vector3d& p, const Vector3d& n_out, double mu,
+                           BodyId carried) const {
     auto it = feeder_index.find(g);
     if (it == feeder_index.end()) return Vector3d::Zero();
     const StepLaw& law = feeders[it->second].frozen;
-    if (carried == kStatic) return toEigen(law.tangentialVelocity(toVec3(p), toVec3(n)));
-    return toEigen(law.tangentialVelocity(toVec3(p), toVec3(n), bodies[carried].state.position));
+    if (law.needsContactSide()) {
+      const double efficiency = carried == kStatic ? 1.0 : bodies[carried].efficiency;
+      return toEigen(law.contactVelocity(toVec3(p), toVec3(n_out), mu, efficiency));
+    }
+    if (carried == kStatic) return toEigen(law.tangentialVelocity(toVec3(p), toVec3(n_out)));
+    return toEigen(
+        law.tangentialVelocity(toVec3(p), toVec3(n_out), bodies[carried].state.position));
   }
 
   void freezeLaws(double h) {
@@ -425,6 +434,19 @@ void World::setFeeder(dGeomID geom, MotionLaw law) {
   impl_->feeders.push_back(Impl::Feeder{geom, std::move(law), StepLaw{}});
 }
 
+void World::setBodyEfficiency(BodyId body, double factor) {
+  if (body < 0 || body >= static_cast<BodyId>(impl_->bodies.size()) ||
+      impl_->bodies[static_cast<std::size_t>(body)].kinematic) {
+    refuse("setBodyEfficiency: body " + std::to_string(body) + " is not a dynamic body");
+  }
+  if (!(factor >= 0 && factor <= 100)) {
+    std::ostringstream out;
+    out << "setBodyEfficiency: factor = " << factor << " must be in [0, 100]";
+    refuse(out.str());
+  }
+  impl_->bodies[static_cast<std::size_t>(body)].efficiency = factor;
+}
+
 void World::setFrictionCallback(FrictionCallback callback) {
   impl_->friction = std::move(callback);
 }
@@ -543,8 +565,8 @@ StepReport World::step(double h) {
     std::vector<Matrix3d> frames(static_cast<std::size_t>(nc));  // columns n, t1, t2
     for (int i = 0; i < nc; ++i) {
       const Impl::RawContact& c = s.raw[static_cast<std::size_t>(i)];
-      const Vector3d c_rel =
-          s.surfaceVelocity(c.g2, c.p, c.n, c.a) - s.surfaceVelocity(c.g1, c.p, c.n, c.b);
+      const Vector3d c_rel = s.surfaceVelocity(c.g2, c.p, c.n, c.mu, c.a) -
+                             s.surfaceVelocity(c.g1, c.p, -c.n, c.mu, c.b);
       const Vector3d c_t = c_rel - c_rel.dot(c.n) * c.n;
       Vector3d t1, t2;
       const double speed = c_t.norm();

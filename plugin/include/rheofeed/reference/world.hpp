@@ -184,6 +184,10 @@ class World {
   /// Make `geom` a feeder with `law` (the plugin's law type; Frame::Body follows the body the
   /// geom is attached to). Throws on an invalid law (names the value).
   void setFeeder(dGeomID geom, MotionLaw law);
+  /// The body's own efficiency under local vibration laws (MotionLaw::localVibration; as
+  /// FeederSet::setPartEfficiency): its feeder contacts get the drift times `factor`
+  /// (dimensionless, in [0, 100]). Throws for a non-dynamic body or a factor out of range.
+  void setBodyEfficiency(BodyId body, double factor);
   /// Per-pair friction coefficient (default: Settings::default_mu everywhere).
   void setFrictionCallback(FrictionCallback callback);
   /// External force (N) and torque (N m) on a body for the next step only (world frame).
