@@ -10,7 +10,10 @@
 //    with each kind of law; a twist with the step given (the secant: a 3 x 3 matrix times a
 //    vector per contact) against the static environment and against a part on a body (the
 //    secant of the body's centre of mass plus w x (p - x_c)), and the instantaneous twist
-//    against a part on a body for comparison.
+//    against a part on a body for comparison; the local vibration law (issue 8) of a translation
+//    on a flat feeder (every contact has the previous contact's inputs) and of a screw vibration
+//    (contacts spread over radius: the table's interpolation), with the table filled before
+//    timing (filling costs milliseconds per cell, once per run).
 //
 // Each pile repetition builds a fresh, identical scene and times the same fixed number of steps,
 // so (a), (b) and (c) see identical work; repetitions are randomly interleaved. The program ends
@@ -160,6 +163,19 @@ void BM_DriveContacts(benchmark::State& state) {
     case 8:
       set.add(feeder, MotionLaw::rotation({0, 0, 1}, {0, 0, 0}));
       break;
+    case 9: {  // the main demo's trough: 50 Hz, 0.25 mm at 30 degrees
+      rheofeed::LocalVibration v;
+      v.amplitude = {2.5e-4 * 0.8660254037844387, 0, 2.5e-4 * 0.5};
+      set.add(feeder, MotionLaw::localVibration(v));
+      break;
+    }
+    case 10: {  // the bowl's screw: 0.15 mm vertical and 0.17 degrees torsion about +z
+      rheofeed::LocalVibration v;
+      v.amplitude = {0, 0, 1.5e-4};
+      v.torsion_amplitude = 0.17 * 3.14159265358979323846 / 180;
+      set.add(feeder, MotionLaw::localVibration(v));
+      break;
+    }
     default:
       break;
   }
@@ -176,8 +192,8 @@ void BM_DriveContacts(benchmark::State& state) {
   std::vector<dContact> tmpl(kCount), work(kCount);
   for (int i = 0; i < kCount; ++i) {
     std::memset(&tmpl[i], 0, sizeof(dContact));
-    tmpl[i].geom.pos[0] = 0.01 * i;
-    tmpl[i].geom.pos[1] = 0.5;
+    tmpl[i].geom.pos[0] = kind == 10 ? 0.13 + 3e-4 * i : 0.01 * i;  // the bowl: r = 130..149 mm
+    tmpl[i].geom.pos[1] = kind == 10 ? 0.0 : 0.5;
     tmpl[i].geom.normal[2] = 1;
     tmpl[i].geom.depth = 1e-3;
     tmpl[i].geom.g1 = part;
@@ -186,6 +202,11 @@ void BM_DriveContacts(benchmark::State& state) {
     tmpl[i].surface.mu = 0.5;
   }
   double t = 0;
+  if (kind >= 9) {  // fill the local law's table before timing
+    std::memcpy(work.data(), tmpl.data(), sizeof(dContact) * kCount);
+    set.beginStep(t += 1e-3, step);
+    set.driveContacts(work.data(), kCount);
+  }
   for (auto _ : state) {
     std::memcpy(work.data(), tmpl.data(), sizeof(dContact) * kCount);
     if (kind > 0) {
@@ -201,7 +222,7 @@ void BM_DriveContacts(benchmark::State& state) {
 }
 BENCHMARK(BM_DriveContacts)
     ->ArgName("law")
-    ->DenseRange(0, 8)
+    ->DenseRange(0, 10)
     ->Repetitions(5)
     ->ReportAggregatesOnly(true);
 
@@ -270,8 +291,10 @@ int main(int argc, char** argv) {
                          "field",
                          "twist secant (step given)",
                          "twist secant carrying a body",
-                         "twist without step, part on a body"};
-  for (int k = 1; k <= 8; ++k) {
+                         "twist without step, part on a body",
+                         "local vibration, translation on a flat feeder",
+                         "local vibration, screw (bowl, r = 130..149 mm)"};
+  for (int k = 1; k <= 10; ++k) {
     const double t = get("BM_DriveContacts/law:" + std::to_string(k));
     if (t > 0 && copy >= 0) {
       std::printf("| driveContacts per %s contact (ns) | %.2f |\n", names[k], (t - copy) / 64.0);

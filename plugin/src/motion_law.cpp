@@ -494,6 +494,17 @@ Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n) const {
 Vec3 StepLaw::contactVelocity(const Vec3& p, const Vec3& n_out, double mu,
                               double efficiency) const {
   if (eval_ != Eval::Local) return tangentialVelocity(p, n_out);
+  if (local_->isTranslation()) {
+    if (!(memo_valid_ && n_out == memo_n_ && mu == memo_mu_)) {
+      memo_value_ = localDrift(*local_, p, n_out, mu, table_, &memo_wall_);
+      memo_n_ = n_out;
+      memo_mu_ = mu;
+      memo_valid_ = true;
+    } else {
+      table_->countContacts(1, memo_wall_ ? 1 : 0);
+    }
+    return (scale_ * efficiency) * memo_value_;
+  }
   return (scale_ * efficiency) * localDrift(*local_, p, n_out, mu, table_);
 }
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <mutex>
@@ -263,7 +264,8 @@ struct LocalDriftTable::Impl {
   std::mutex mutex;
   std::unordered_map<CornerKey, Corner, CornerKeyHash> corners;
   std::unordered_map<CornerKey, Cell, CornerKeyHash> cells;
-  LocalDriftStats stats;
+  LocalDriftStats stats;  // cells and model runs (under the mutex)
+  std::atomic<std::int64_t> contacts{0}, wall_contacts{0};
   bool has_last = false;
   PointMassParams last_params;
   PointMassDrift last_result;
@@ -292,7 +294,15 @@ LocalDriftTable::~LocalDriftTable() = default;
 
 LocalDriftStats LocalDriftTable::stats() const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
-  return impl_->stats;
+  LocalDriftStats out = impl_->stats;
+  out.contacts = impl_->contacts.load(std::memory_order_relaxed);
+  out.wall_contacts = impl_->wall_contacts.load(std::memory_order_relaxed);
+  return out;
+}
+
+void LocalDriftTable::countContacts(std::int64_t contacts, std::int64_t walls) {
+  impl_->contacts.fetch_add(contacts, std::memory_order_relaxed);
+  if (walls != 0) impl_->wall_contacts.fetch_add(walls, std::memory_order_relaxed);
 }
 
 PointMassDrift LocalDriftTable::drift(const PointMassParams& p) {
@@ -432,11 +442,7 @@ Vec3 localDrift(const LocalVibration& vibration, const Vec3& p, const Vec3& n_ou
     const Vec3 up = (-1.0 / g) * vibration.gravity;
     drift = tangentialPart(planeDrift(vibration, p, up, mu, table, &ok), n_out);
   }
-  if (table) {
-    std::lock_guard<std::mutex> lock(table->impl_->mutex);
-    ++table->impl_->stats.contacts;
-    if (use_wall) ++table->impl_->stats.wall_contacts;
-  }
+  if (table) table->countContacts(1, use_wall ? 1 : 0);
   if (wall) *wall = use_wall;
   return drift;
 }

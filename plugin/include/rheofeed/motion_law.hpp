@@ -234,6 +234,8 @@ class MotionLaw {
 };
 
 /// A law frozen at one time step in the world frame: what the per-contact evaluation reads.
+/// Not thread-safe (a local vibration law keeps its last contact's result): use one StepLaw
+/// per thread.
 class StepLaw {
  public:
   /// Tangential surface velocity c_t (m/s, world) at contact point `p` (m, world) with unit
@@ -292,6 +294,12 @@ class StepLaw {
   const SurfaceField* field_ = nullptr;
   const LocalVibration* local_ = nullptr;  // Local: the law's vibration and table
   LocalDriftTable* table_ = nullptr;
+  // Local, translation only: the value does not depend on p, so the last contact's inputs and
+  // result are kept (a flat translating feeder computes its drift once per step).
+  mutable bool memo_valid_ = false;
+  mutable Vec3 memo_n_, memo_value_;
+  mutable double memo_mu_ = 0;
+  mutable bool memo_wall_ = false;
   double scale_ = 1.0;
   double time_ = 0.0;
   bool time_varying_field_ = false;

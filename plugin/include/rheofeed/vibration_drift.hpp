@@ -152,10 +152,10 @@ class LocalDriftTable {
   /// a corner of the cell is outside the model (then the exact model is tried at the point).
   PointMassDrift drift(const PointMassParams& params);
   LocalDriftStats stats() const;
+  /// Adds to the contact counts of stats() (localDrift and the callers' caches count here).
+  void countContacts(std::int64_t contacts, std::int64_t wall_contacts);
 
  private:
-  friend Vec3 localDrift(const LocalVibration&, const Vec3&, const Vec3&, double, LocalDriftTable*,
-                         bool*);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
