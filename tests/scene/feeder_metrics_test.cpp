@@ -228,6 +228,11 @@ TEST(FeederMetrics, FirstExitRateAndCountOfAFreeFallFlowMatchKinematics) {
       }
     }
     EXPECT_EQ(f.rate.back().cumulative, kCount);
+    // From the first to the last exit the flow is the spawn rate: kCount - 1 intervals of
+    // 1 / kRate, each exact to twice the interpolation tolerance.
+    const double span = (kCount - 1) / kRate;
+    EXPECT_NEAR(f.mean_rate_per_min, 60 * kRate,
+                60 * kRate * 2 * kInterpolationTolerance / (span - 2 * kInterpolationTolerance));
     ASSERT_EQ(f.families.size(), 1u);
     EXPECT_EQ(f.families[0].spawned, kCount);
     EXPECT_EQ(f.families[0].exited, kCount);
@@ -308,6 +313,7 @@ TEST(FeederMetrics, NoPartReachingTheExitIsSaid) {
   EXPECT_TRUE(j["feeder"]["first_exit_time_s"].is_null());
   EXPECT_EQ(j["feeder"]["note"], "no part reached the exit in 0.1 s");
   EXPECT_EQ(j["feeder"]["parts_exited"], 0);
+  EXPECT_TRUE(j["feeder"]["mean_exit_rate_per_min"].is_null());
 }
 
 TEST(FeederMetrics, SceneWithoutExitPlaneSaysSoAndWritesNoExitFiles) {

@@ -110,7 +110,9 @@ UpAxis upAxis(const double rotation[9], const Vec3& up) {
 
 Vec3 upDirection(const Vec3& gravity) {
   const double g = norm(gravity);
-  return g > 0 ? (-1.0 / g) * gravity : Vec3{0, 0, 1};
+  if (!(g > 0)) return Vec3{0, 0, 1};
+  const Vec3 up = (-1.0 / g) * gravity;
+  return {up.x + 0.0, up.y + 0.0, up.z + 0.0};  // + 0.0: no negative zeros in the outputs
 }
 
 double exitRateWindow(double duration, double sample_interval) {
@@ -344,6 +346,10 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
 
   std::sort(feeder.exit_times.begin(), feeder.exit_times.end());
   if (!feeder.exit_times.empty()) feeder.first_exit_time = feeder.exit_times.front();
+  if (feeder.exit_times.size() >= 2 && feeder.exit_times.back() > feeder.exit_times.front()) {
+    feeder.mean_rate_per_min = 60.0 * double(feeder.exit_times.size() - 1) /
+                               (feeder.exit_times.back() - feeder.exit_times.front());
+  }
   if (m.simulated_seconds > 0) {
     feeder.rate_window = exitRateWindow(m.simulated_seconds, out.sample_interval);
     if (out.exit_plane) {

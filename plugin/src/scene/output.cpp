@@ -141,6 +141,7 @@ std::string feederJson(const FeederMetrics& f) {
     << jsonNumber(f.up.x) << ", " << jsonNumber(f.up.y) << ", " << jsonNumber(f.up.z)
     << "], \"first_exit_time_s\": " << jsonNumber(f.first_exit_time)
     << ", \"note\": " << (f.note.empty() ? "null" : jsonQuoted(f.note))
+    << ", \"mean_exit_rate_per_min\": " << jsonNumber(f.mean_rate_per_min)
     << ", \"rate_window_s\": " << jsonNumber(f.rate_window)
     << ", \"parts_exited\": " << f.exit_times.size()
     << ", \"spawned_beyond_exit\": " << f.spawned_beyond_exit << ", \"exit_rate_per_min\": [";
@@ -198,22 +199,35 @@ std::vector<std::string> writeFeederOutputs(const FeederMetrics& feeder,
     times << jsonNumber(feeder.exit_times[k]) << "," << k + 1 << "\n";
   }
   times << jsonNumber(end) << "," << feeder.exit_times.size() << "\n";
+  // The mean rate over the span it is measured on.
+  std::string mean = "t_s,rate_per_min\n";
+  if (std::isfinite(feeder.mean_rate_per_min)) {
+    const std::string rate = jsonNumber(feeder.mean_rate_per_min);
+    mean += jsonNumber(feeder.exit_times.front()) + "," + rate + "\n" +
+            jsonNumber(feeder.exit_times.back()) + "," + rate + "\n";
+  }
   const std::string heading = gnuplotText(title);
   std::ostringstream gp;
-  gp << "set datafile separator ','\nset grid\nset key top left\n"
+  gp << "set datafile separator ','\nset grid\nset key top left opaque\n"
      << "set multiplot layout 2,1 title '" << heading << ": " << feeder.exit_times.size()
      << " parts out"
      << (feeder.exit_times.empty() ? " (" + gnuplotText(feeder.note) + ")" : std::string()) << "'\n"
      << "set xrange [0:" << jsonNumber(end)
      << "]\nset yrange [0:" << (feeder.exit_times.empty() ? "1" : "*") << "]\n"
-     << "set ylabel 'output rate (parts/min)'\nset style fill solid 0.5\n"
+     << "set ylabel 'output rate (parts/min)'\nset style fill solid 0.5\nset offsets 0, 0, graph "
+        "0.15, 0\n"
      << "plot $exits using (($1+$2)/2):4:($2-$1) with boxes lc rgb '#1040a0' title 'window of "
-     << jsonNumber(feeder.rate_window) << " s'\n"
-     << "set xlabel 'time (s)'\nset ylabel 'parts out (cumulative)'\n"
+     << jsonNumber(feeder.rate_window) << " s'"
+     << (std::isfinite(feeder.mean_rate_per_min)
+             ? ", $mean using 1:2 with lines dt 2 lw 2 lc rgb '#a02010' title 'mean, first to "
+               "last exit'"
+             : std::string())
+     << "\n"
+     << "set offsets 0, 0, 0, 0\nset xlabel 'time (s)'\nset ylabel 'parts out (cumulative)'\n"
      << "plot $times using 1:2 with steps lw 2 lc rgb '#a02010' title 'cumulative'\n"
      << "unset multiplot\n";
   const std::string exits_png = base + "_exits.png";
-  if (plotPng(gp.str(), {{"exits", exits}, {"times", times.str()}}, exits_png)) {
+  if (plotPng(gp.str(), {{"exits", exits}, {"times", times.str()}, {"mean", mean}}, exits_png)) {
     written.push_back(exits_png);
   }
 

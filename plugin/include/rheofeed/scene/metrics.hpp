@@ -102,6 +102,9 @@ struct FeederMetrics {
   std::vector<double> exit_times;
   /// The first crossing (s); NaN when no part crossed (see `note`).
   double first_exit_time = std::numeric_limits<double>::quiet_NaN();
+  /// Mean output rate from the first to the last exit: (n - 1) / (t_last - t_first) x 60
+  /// (parts per minute); NaN with fewer than two exits or all at one time.
+  double mean_rate_per_min = std::numeric_limits<double>::quiet_NaN();
   double rate_window = 0;        ///< width of the rate windows (s), exitRateWindow
   std::vector<RateWindow> rate;  ///< output rate and cumulative count over the run
   /// Parts spawned on the exit side of the plane: never counted as exits (said on stderr).

@@ -28,10 +28,11 @@ std::string exitsCsv(const FeederMetrics& feeder);
 std::string orientationCsv(const FeederMetrics& feeder);
 /// The JSON object of the feeder metrics (no surrounding key):
 /// {"exit_plane", "up", "first_exit_time_s" (null when none), "note" (null when empty),
-/// "rate_window_s", "parts_exited", "spawned_beyond_exit", "exit_rate_per_min": [{"t_s" (window
-/// centre), "t_start_s", "t_end_s", "exits", "rate_per_min", "cumulative_exits"}],
-/// "exit_times_s": [...], "families": {name: {"shape", "spawned", "exited",
-/// "removed_without_exit", "orientation_meaningful"}}, "exit_orientation": {name: {"+x": n,
+/// "mean_exit_rate_per_min" (null with fewer than two exits), "rate_window_s", "parts_exited",
+/// "spawned_beyond_exit", "exit_rate_per_min": [{"t_s" (window centre), "t_start_s", "t_end_s",
+/// "exits", "rate_per_min", "cumulative_exits"}], "exit_times_s": [...], "families": {name:
+/// {"shape", "spawned", "exited", "removed_without_exit", "orientation_meaningful"}},
+/// "exit_orientation": {name: {"+x": n,
 /// ..., "-z": n}}}. A family whose name repeats an earlier one is keyed "name[k]" (k its index
 /// in Scene::parts).
 std::string feederJson(const FeederMetrics& feeder);
