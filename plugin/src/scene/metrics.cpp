@@ -8,6 +8,7 @@
 #include <ctime>
 #include <filesystem>
 #include <sstream>
+#include <stdexcept>
 
 #include "rheofeed/scene/check.hpp"
 #include "rheofeed/scene/output.hpp"
@@ -28,6 +29,10 @@ struct Track {
   Vec3 end;  // position when it stopped (exit or run end)
   double end_time = -1;
   bool exited = false;
+  Vec3 last;              // position at the previous observation (every step) (m)
+  double last_time = -1;  // time of that observation (s)
+  bool crossed = false;   // crossed the exit plane (FeederMetrics)
+  bool removed = false;   // taken out of the simulation before crossing
 };
 
 constexpr double kPi = 3.14159265358979323846;
@@ -71,6 +76,98 @@ double studentT95(int dof) {
   return 1.96;
 }
 
+const char* toString(UpAxis axis) {
+  switch (axis) {
+    case UpAxis::PlusX:
+      return "+x";
+    case UpAxis::MinusX:
+      return "-x";
+    case UpAxis::PlusY:
+      return "+y";
+    case UpAxis::MinusY:
+      return "-y";
+    case UpAxis::PlusZ:
+      return "+z";
+    case UpAxis::MinusZ:
+      return "-z";
+  }
+  return "?";
+}
+
+UpAxis upAxis(const double rotation[9], const Vec3& up) {
+  // Body axis k in the world is column k of R: its component along up is (R^T up)_k.
+  int best = 0;
+  double best_component = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double c = rotation[k] * up.x + rotation[3 + k] * up.y + rotation[6 + k] * up.z;
+    if (std::abs(c) > std::abs(best_component)) {
+      best = k;
+      best_component = c;
+    }
+  }
+  return static_cast<UpAxis>(2 * best + (best_component < 0 ? 1 : 0));
+}
+
+Vec3 upDirection(const Vec3& gravity) {
+  const double g = norm(gravity);
+  if (!(g > 0)) return Vec3{0, 0, 1};
+  const Vec3 up = (-1.0 / g) * gravity;
+  return {up.x + 0.0, up.y + 0.0, up.z + 0.0};  // + 0.0: no negative zeros in the outputs
+}
+
+double exitRateWindow(double duration, double sample_interval) {
+  return std::max(sample_interval, duration / kRateWindowsPerRun);
+}
+
+std::vector<RateWindow> exitRate(const std::vector<double>& exit_times, double end_time,
+                                 double window) {
+  auto require = [](const char* what, double value) {
+    if (!(std::isfinite(value) && value > 0)) {
+      std::ostringstream msg;
+      msg << "exit rate: " << what << " = " << value << " s: must be a finite number > 0";
+      throw std::invalid_argument(msg.str());
+    }
+  };
+  require("window", window);
+  require("end time", end_time);
+  // The relative slack keeps round-off in end_time / window from adding a sliver window.
+  const long n = std::max(1L, static_cast<long>(std::ceil(end_time / window - 1e-9)));
+  std::vector<RateWindow> out(static_cast<std::size_t>(n));
+  for (long k = 0; k < n; ++k) {
+    RateWindow& w = out[static_cast<std::size_t>(k)];
+    w.start = k * window;
+    w.end = k == n - 1 ? end_time : (k + 1) * window;
+  }
+  for (double t : exit_times) {
+    const long k = std::min(n - 1, std::max(0L, static_cast<long>(std::floor(t / window))));
+    ++out[static_cast<std::size_t>(k)].exits;
+  }
+  int cumulative = 0;
+  for (RateWindow& w : out) {
+    cumulative += w.exits;
+    w.cumulative = cumulative;
+    w.rate_per_min = 60.0 * w.exits / (w.end - w.start);
+  }
+  return out;
+}
+
+std::vector<int> partFamilies(const Scene& scene) {
+  // drawParts: parts family by family, then a stable sort on the spawn time i / rate.
+  std::vector<std::pair<double, int>> order;
+  for (std::size_t s = 0; s < scene.parts.size(); ++s) {
+    const PartSpec& spec = scene.parts[s];
+    for (int i = 0; i < spec.count; ++i) {
+      order.emplace_back(spec.rate > 0 ? i / spec.rate : 0.0, static_cast<int>(s));
+    }
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<int> family;
+  family.reserve(order.size());
+  for (const auto& entry : order) family.push_back(entry.second);
+  return family;
+}
+
 RunMetrics measureRun(const Scene& scene, Method method, const Progress& progress) {
   std::unique_ptr<Simulation> sim = makeSimulation(scene, method);
   const double h = scene.solver.time_step;
@@ -96,6 +193,29 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
   std::vector<Track> tracks;
   int exited_total = 0, exited_after_warmup = 0;
 
+  FeederMetrics& feeder = m.feeder;
+  feeder.exit_plane = out.exit_plane;
+  feeder.up = upDirection(scene.gravity);
+  const std::vector<int> family = partFamilies(scene);
+  for (const PartSpec& spec : scene.parts) {
+    FamilyExits f;
+    f.name = spec.name;
+    f.shape = spec.shape;
+    f.orientation_meaningful = spec.shape != Shape::Kind::Sphere;
+    feeder.families.push_back(f);
+  }
+  auto familyOf = [&](int i) -> FamilyExits& {
+    return feeder.families[static_cast<std::size_t>(family.at(static_cast<std::size_t>(i)))];
+  };
+  // A crossing between the previous observation and this one at time t: the time where the
+  // signed distance to the plane, linear between the two, is zero.
+  auto crossingTime = [&](const Track& tr, const Vec3& x, double t) {
+    const double d0 = dot(tr.last - out.exit_point, out.exit_normal);
+    const double d1 = dot(x - out.exit_point, out.exit_normal);
+    if (tr.last_time < 0 || !(d0 < 0) || !(d1 > d0)) return t;
+    return tr.last_time + (t - tr.last_time) * (-d0 / (d1 - d0));
+  };
+
   auto crossed = [&](const Vec3& x) { return beyondExitPlane(out, x); };
   // Drift coordinate progress of a part between two observations: along d, or the unwrapped
   // angle about the axis.
@@ -116,6 +236,10 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
       tr.has_previous = true;
       if (angular) tr.angle = angleAbout(tr.spawn, out.axis_origin, out.axis_direction);
       tr.exited = out.exit_plane && crossed(tr.spawn);  // spawned beyond the exit: never counted
+      if (tr.exited) ++feeder.spawned_beyond_exit;
+      tr.last = tr.spawn;
+      tr.last_time = t;
+      ++familyOf(i).spawned;
       tracks.push_back(tr);
     }
     std::vector<double> v;
@@ -129,6 +253,8 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
       turn(tr, x);
       if (!state.active) {  // removed (fell out of the scene): its measurement ends here
         tr.exited = true;
+        tr.removed = true;
+        ++familyOf(i).removed_without_exit;
         tr.end = x;
         tr.end_turned = tr.turned;
         tr.end_time = t;
@@ -140,6 +266,11 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
         tr.start_time = t;
       }
       if (out.exit_plane && crossed(x)) {
+        tr.crossed = true;
+        feeder.exit_times.push_back(crossingTime(tr, x, t));
+        FamilyExits& f = familyOf(i);
+        ++f.exited;
+        ++f.up_axis[static_cast<std::size_t>(upAxis(state.rotation, feeder.up))];
         tr.exited = true;
         tr.end = x;
         tr.end_turned = tr.turned;
@@ -148,6 +279,8 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
         if (t > out.warmup) ++exited_after_warmup;
         continue;
       }
+      tr.last = x;
+      tr.last_time = t;
       if (sample) {
         const double advance = angular ? tr.turned - tr.previous_turned : dot(x - tr.previous, d);
         v.push_back(advance / (every * h));
@@ -210,6 +343,35 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
   const double window = m.simulated_seconds - out.warmup;
   m.throughput = window > 0 ? exited_after_warmup / window : 0;
   m.health = sim->health();
+
+  std::sort(feeder.exit_times.begin(), feeder.exit_times.end());
+  if (!feeder.exit_times.empty()) feeder.first_exit_time = feeder.exit_times.front();
+  if (feeder.exit_times.size() >= 2 && feeder.exit_times.back() > feeder.exit_times.front()) {
+    feeder.mean_rate_per_min = 60.0 * double(feeder.exit_times.size() - 1) /
+                               (feeder.exit_times.back() - feeder.exit_times.front());
+  }
+  if (m.simulated_seconds > 0) {
+    feeder.rate_window = exitRateWindow(m.simulated_seconds, out.sample_interval);
+    if (out.exit_plane) {
+      feeder.rate = exitRate(feeder.exit_times, m.simulated_seconds, feeder.rate_window);
+    }
+  }
+  char note[160];
+  if (!out.exit_plane) {
+    feeder.note = "the scene has no exit plane (outputs.exit_plane is false): no exit metrics";
+  } else if (feeder.exit_times.empty()) {
+    std::snprintf(note, sizeof note, "no part reached the exit in %g s", m.simulated_seconds);
+    feeder.note = note;
+  }
+  if (out.exit_plane && (feeder.exit_times.empty() || feeder.spawned_beyond_exit > 0)) {
+    std::fprintf(stderr, "rheofeed: %s, %s: ", scene.name.c_str(), toString(method));
+    if (feeder.exit_times.empty()) std::fprintf(stderr, "%s", feeder.note.c_str());
+    if (feeder.spawned_beyond_exit > 0) {
+      std::fprintf(stderr, "%s%d parts spawned beyond the exit plane (not counted as exits)",
+                   feeder.exit_times.empty() ? "; " : "", feeder.spawned_beyond_exit);
+    }
+    std::fprintf(stderr, "\n");
+  }
   if (progress) progress(1.0);
   if (m.health.anything()) {
     std::fprintf(stderr, "rheofeed: %s, %s: %s\n", scene.name.c_str(), toString(method),
@@ -305,28 +467,6 @@ std::string healthSummary(const RunHealth& h, int parts) {
   return s.str();
 }
 
-namespace {
-
-// A JSON string literal.
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char esc[8];
-      std::snprintf(esc, sizeof esc, "\\u%04x", static_cast<unsigned>(c));
-      out += esc;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
-}  // namespace
-
 std::string summaryJson(const RunMetrics& r) {
   char b[768];
   std::snprintf(b, sizeof b,
@@ -354,15 +494,15 @@ std::string summaryJson(const RunMetrics& r) {
                 h.steps > 0 ? double(h.coulomb_fallback_steps) / h.steps : 0.0,
                 h.solver_unconverged_steps, h.friction_dropped_contacts,
                 h.gyroscopic_fallback_steps, h.max_part_speed, h.speed_bound);
-  std::string json = "{\"scene\": " + quoted(r.scene) + b + c;
+  std::string json = "{\"scene\": " + jsonQuoted(r.scene) + b + c;
   for (std::size_t k = 0; k < h.ignored_settings.size(); ++k) {
-    json += (k ? ", " : "") + quoted(h.ignored_settings[k]);
+    json += (k ? ", " : "") + jsonQuoted(h.ignored_settings[k]);
   }
   json += "]}, \"scene_check\": [";
   for (std::size_t k = 0; k < r.scene_check.size(); ++k) {
-    json += (k ? ", " : "") + quoted(r.scene_check[k]);
+    json += (k ? ", " : "") + jsonQuoted(r.scene_check[k]);
   }
-  return json + "]}";
+  return json + "], \"feeder\": " + feederJson(r.feeder) + "}";
 }
 
 std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::string& folder,
@@ -387,6 +527,10 @@ std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::strin
         "$data using 1:3 with lines lw 2 lc rgb '#1040a0' title 'mean over parts'\n";
   const std::string png = base.string() + ".png";
   if (plotPng(gp.str(), {{"data", csv}}, png)) written.push_back(png);
+  const std::string title = run.scene + ": " + toString(run.method);
+  for (const std::string& path : writeFeederOutputs(run.feeder, folder, stem, title)) {
+    written.push_back(path);
+  }
   return written;
 }
 

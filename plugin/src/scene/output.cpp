@@ -1,9 +1,15 @@
 // SPDX-License-Identifier: MIT
 #include "rheofeed/scene/output.hpp"
 
+#include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <set>
+#include <sstream>
 #include <stdexcept>
 #include <system_error>
+
+#include "rheofeed/scene/plot.hpp"
 
 namespace rheofeed::scene {
 
@@ -31,6 +37,229 @@ void writeFileAtomically(const std::filesystem::path& path, const std::string& t
     std::filesystem::remove(tmp, ec);
     throw std::runtime_error("cannot rename " + tmp.string() + " to " + path.string());
   }
+}
+
+std::string jsonQuoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char esc[8];
+      std::snprintf(esc, sizeof esc, "\\u%04x", static_cast<unsigned>(c));
+      out += esc;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+namespace {
+
+// A number for JSON: %.8g, null when not finite.
+std::string jsonNumber(double x) {
+  if (!std::isfinite(x)) return "null";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.8g", x);
+  return b;
+}
+
+// The JSON keys of the families: the name, or "name[k]" when an earlier family has that name.
+std::vector<std::string> familyKeys(const FeederMetrics& f) {
+  std::vector<std::string> keys;
+  std::set<std::string> seen;
+  for (std::size_t k = 0; k < f.families.size(); ++k) {
+    std::string key = f.families[k].name;
+    if (!seen.insert(key).second) {
+      key += "[" + std::to_string(k) + "]";
+      seen.insert(key);
+    }
+    keys.push_back(key);
+  }
+  return keys;
+}
+
+// A family name as a file name part: letters, digits, '-' and '_' kept, others '_'.
+std::string fileNamePart(const std::string& name) {
+  std::string out;
+  for (char c : name) {
+    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      c == '-' || c == '_';
+    out += keep ? c : '_';
+  }
+  return out.empty() ? "family" : out;
+}
+
+// Text for a single-quoted gnuplot string.
+std::string gnuplotText(const std::string& text) {
+  std::string out;
+  for (char c : text) out += c == '\'' ? '"' : c;
+  return out;
+}
+
+}  // namespace
+
+std::string exitsCsv(const FeederMetrics& feeder) {
+  std::ostringstream s;
+  s << "window_start_s,window_end_s,exits,rate_per_min,cumulative_exits\n";
+  char line[160];
+  for (const RateWindow& w : feeder.rate) {
+    std::snprintf(line, sizeof line, "%.6f,%.6f,%d,%.8g,%d\n", w.start, w.end, w.exits,
+                  w.rate_per_min, w.cumulative);
+    s << line;
+  }
+  return s.str();
+}
+
+std::string orientationCsv(const FeederMetrics& feeder) {
+  std::ostringstream s;
+  s << "family,shape,spawned,exited,removed_without_exit,orientation_meaningful";
+  for (int a = 0; a < kUpAxisCount; ++a) s << "," << toString(static_cast<UpAxis>(a));
+  s << "\n";
+  const std::vector<std::string> keys = familyKeys(feeder);
+  for (std::size_t k = 0; k < feeder.families.size(); ++k) {
+    const FamilyExits& f = feeder.families[k];
+    std::string name = keys[k];  // CSV: a name with a comma or quote is quoted
+    if (name.find_first_of(",\"\n") != std::string::npos) {
+      std::string q = "\"";
+      for (char c : name) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+      name = q + "\"";
+    }
+    s << name << "," << toString(f.shape) << "," << f.spawned << "," << f.exited << ","
+      << f.removed_without_exit << "," << (f.orientation_meaningful ? "true" : "false");
+    for (int n : f.up_axis) s << "," << n;
+    s << "\n";
+  }
+  return s.str();
+}
+
+std::string feederJson(const FeederMetrics& f) {
+  std::ostringstream s;
+  s << "{\"exit_plane\": " << (f.exit_plane ? "true" : "false") << ", \"up\": ["
+    << jsonNumber(f.up.x) << ", " << jsonNumber(f.up.y) << ", " << jsonNumber(f.up.z)
+    << "], \"first_exit_time_s\": " << jsonNumber(f.first_exit_time)
+    << ", \"note\": " << (f.note.empty() ? "null" : jsonQuoted(f.note))
+    << ", \"mean_exit_rate_per_min\": " << jsonNumber(f.mean_rate_per_min)
+    << ", \"rate_window_s\": " << jsonNumber(f.rate_window)
+    << ", \"parts_exited\": " << f.exit_times.size()
+    << ", \"spawned_beyond_exit\": " << f.spawned_beyond_exit << ", \"exit_rate_per_min\": [";
+  for (std::size_t k = 0; k < f.rate.size(); ++k) {
+    const RateWindow& w = f.rate[k];
+    s << (k ? ", " : "") << "{\"t_s\": " << jsonNumber(0.5 * (w.start + w.end))
+      << ", \"t_start_s\": " << jsonNumber(w.start) << ", \"t_end_s\": " << jsonNumber(w.end)
+      << ", \"exits\": " << w.exits << ", \"rate_per_min\": " << jsonNumber(w.rate_per_min)
+      << ", \"cumulative_exits\": " << w.cumulative << "}";
+  }
+  s << "], \"exit_times_s\": [";
+  for (std::size_t k = 0; k < f.exit_times.size(); ++k) {
+    s << (k ? ", " : "") << jsonNumber(f.exit_times[k]);
+  }
+  const std::vector<std::string> keys = familyKeys(f);
+  s << "], \"families\": {";
+  for (std::size_t k = 0; k < f.families.size(); ++k) {
+    const FamilyExits& fam = f.families[k];
+    s << (k ? ", " : "") << jsonQuoted(keys[k])
+      << ": {\"shape\": " << jsonQuoted(toString(fam.shape)) << ", \"spawned\": " << fam.spawned
+      << ", \"exited\": " << fam.exited
+      << ", \"removed_without_exit\": " << fam.removed_without_exit
+      << ", \"orientation_meaningful\": " << (fam.orientation_meaningful ? "true" : "false") << "}";
+  }
+  s << "}, \"exit_orientation\": {";
+  for (std::size_t k = 0; k < f.families.size(); ++k) {
+    s << (k ? ", " : "") << jsonQuoted(keys[k]) << ": {";
+    for (int a = 0; a < kUpAxisCount; ++a) {
+      s << (a ? ", " : "") << "\"" << toString(static_cast<UpAxis>(a))
+        << "\": " << f.families[k].up_axis[static_cast<std::size_t>(a)];
+    }
+    s << "}";
+  }
+  s << "}}";
+  return s.str();
+}
+
+std::vector<std::string> writeFeederOutputs(const FeederMetrics& feeder,
+                                            const std::filesystem::path& folder,
+                                            const std::string& stem, const std::string& title) {
+  std::vector<std::string> written;
+  if (!feeder.exit_plane) return written;
+  const std::string base = (folder / stem).string();
+  const std::string exits = exitsCsv(feeder);
+  writeFileAtomically(base + "_exits.csv", exits);
+  written.push_back(base + "_exits.csv");
+  writeFileAtomically(base + "_orientation.csv", orientationCsv(feeder));
+  written.push_back(base + "_orientation.csv");
+
+  // Cumulative count as a step function of the exact exit times.
+  const double end = feeder.rate.empty() ? 0 : feeder.rate.back().end;
+  std::ostringstream times;
+  times << "t_s,cumulative\n0,0\n";
+  for (std::size_t k = 0; k < feeder.exit_times.size(); ++k) {
+    times << jsonNumber(feeder.exit_times[k]) << "," << k + 1 << "\n";
+  }
+  times << jsonNumber(end) << "," << feeder.exit_times.size() << "\n";
+  // The mean rate over the span it is measured on.
+  std::string mean = "t_s,rate_per_min\n";
+  if (std::isfinite(feeder.mean_rate_per_min)) {
+    const std::string rate = jsonNumber(feeder.mean_rate_per_min);
+    mean += jsonNumber(feeder.exit_times.front()) + "," + rate + "\n" +
+            jsonNumber(feeder.exit_times.back()) + "," + rate + "\n";
+  }
+  const std::string heading = gnuplotText(title);
+  std::ostringstream gp;
+  gp << "set datafile separator ','\nset grid\nset key top left opaque\n"
+     << "set multiplot layout 2,1 title '" << heading << ": " << feeder.exit_times.size()
+     << " parts out"
+     << (feeder.exit_times.empty() ? " (" + gnuplotText(feeder.note) + ")" : std::string()) << "'\n"
+     << "set xrange [0:" << jsonNumber(end)
+     << "]\nset yrange [0:" << (feeder.exit_times.empty() ? "1" : "*") << "]\n"
+     << "set ylabel 'output rate (parts/min)'\nset style fill solid 0.5\nset offsets 0, 0, graph "
+        "0.15, 0\n"
+     << "plot $exits using (($1+$2)/2):4:($2-$1) with boxes lc rgb '#1040a0' title 'window of "
+     << jsonNumber(feeder.rate_window) << " s'"
+     << (std::isfinite(feeder.mean_rate_per_min)
+             ? ", $mean using 1:2 with lines dt 2 lw 2 lc rgb '#a02010' title 'mean, first to "
+               "last exit'"
+             : std::string())
+     << "\n"
+     << "set offsets 0, 0, 0, 0\nset xlabel 'time (s)'\nset ylabel 'parts out (cumulative)'\n"
+     << "plot $times using 1:2 with steps lw 2 lc rgb '#a02010' title 'cumulative'\n"
+     << "unset multiplot\n";
+  const std::string exits_png = base + "_exits.png";
+  if (plotPng(gp.str(), {{"exits", exits}, {"times", times.str()}, {"mean", mean}}, exits_png)) {
+    written.push_back(exits_png);
+  }
+
+  const std::vector<std::string> keys = familyKeys(feeder);
+  std::set<std::string> used;
+  for (std::size_t k = 0; k < feeder.families.size(); ++k) {
+    const FamilyExits& f = feeder.families[k];
+    std::string part = fileNamePart(f.name);
+    if (!used.insert(part).second) {
+      part += "_" + std::to_string(k);
+      used.insert(part);
+    }
+    std::ostringstream bins;
+    bins << "axis,parts\n";
+    for (int a = 0; a < kUpAxisCount; ++a) {
+      bins << toString(static_cast<UpAxis>(a)) << "," << f.up_axis[static_cast<std::size_t>(a)]
+           << "\n";
+    }
+    std::ostringstream hp;
+    hp << "set datafile separator ','\nset grid ytics\nset key off\n"
+       << "set title '" << heading << ": " << gnuplotText(keys[k]) << " (" << toString(f.shape)
+       << "), " << f.exited << " of " << f.spawned << " parts out"
+       << (f.orientation_meaningful ? "" : "; a sphere has no axis: orientation meaningless")
+       << "'\n"
+       << "set xlabel 'body axis pointing up at the exit'\nset ylabel 'parts'\n"
+       << "set yrange [0:" << (f.exited > 0 ? "*" : "1") << "]\nset xrange [-0.5:5.5]\n"
+       << "set boxwidth 0.6\nset style fill solid 0.6\n"
+       << "plot $bins using 0:2:xtic(1) with boxes lc rgb '#208040'\n";
+    const std::string png = base + "_orientation_" + part + ".png";
+    if (plotPng(hp.str(), {{"bins", bins.str()}}, png)) written.push_back(png);
+  }
+  return written;
 }
 
 }  // namespace rheofeed::scene

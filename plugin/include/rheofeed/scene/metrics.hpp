@@ -10,9 +10,15 @@
 /// displacement over an interval that spans whole vibration cycles is the transport itself.
 /// With Outputs::angular_drift the same is done with the unwrapped angle of each part about the
 /// axis: drift velocities are then angular velocities (rad/s).
+///
+/// Feeder metrics (FeederMetrics) are what a feeder is bought for: the parts per minute through
+/// the exit plane over time, the cumulative count, the time to the first part out, and per part
+/// family the exit orientation - which body axis points up when the part crosses the exit.
 #pragma once
 
+#include <array>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -30,6 +36,83 @@ struct DriftSample {
   int exited = 0;            ///< parts that have crossed the exit plane so far
   /// Parts lost so far, by kind (RunHealth, cumulative at `time`).
   int fell = 0, through_fixture = 0, out_of_bounds = 0, nonfinite = 0, too_fast = 0;
+};
+
+/// Exit orientation bins: the body axis that points most nearly up, with its sign.
+enum class UpAxis { PlusX, MinusX, PlusY, MinusY, PlusZ, MinusZ };
+constexpr int kUpAxisCount = 6;
+/// Printable name of an UpAxis: "+x", "-x", "+y", "-y", "+z", "-z".
+const char* toString(UpAxis axis);
+
+/// The body axis (with its sign) of a part with `rotation` (body to world, row-major, as in
+/// PartState) that points most nearly along `up` (unit, world frame): the largest |component|
+/// of R^T up. Ties go to the first of x, y, z.
+UpAxis upAxis(const double rotation[9], const Vec3& up);
+
+/// "Up" for the exit orientation: -gravity / |gravity| (world frame, unit); +z when the scene
+/// has no gravity.
+Vec3 upDirection(const Vec3& gravity);
+
+/// Parts per minute through the exit plane in one window of time.
+struct RateWindow {
+  double start = 0;         ///< (s)
+  double end = 0;           ///< (s), > start; the last window may be shorter than the others
+  int exits = 0;            ///< parts that crossed the exit plane in [start, end)
+  double rate_per_min = 0;  ///< exits / (end - start) x 60 (parts per minute)
+  int cumulative = 0;       ///< parts that crossed the exit plane in [0, end)
+};
+
+/// Number of windows over a run's duration for the output rate (exitRateWindow).
+constexpr int kRateWindowsPerRun = 50;
+
+/// The window of the output rate (s): max(sample_interval, duration / kRateWindowsPerRun), so
+/// that a run has at most 50 windows and no window is shorter than a metric sample.
+double exitRateWindow(double duration, double sample_interval);
+
+/// Bins the exit times (s, each in [0, end_time]) into windows of `window` seconds covering
+/// [0, end_time] (the last window ends at end_time and may be shorter). Throws
+/// std::invalid_argument when window or end_time is not a finite number > 0.
+std::vector<RateWindow> exitRate(const std::vector<double>& exit_times, double end_time,
+                                 double window);
+
+/// The spawn order's part family: element i is the PartSpec index (Scene::parts) of the i-th
+/// spawned part (Simulation::part(i)), the order of drawParts without drawing the parts.
+std::vector<int> partFamilies(const Scene& scene);
+
+/// Per part family (one PartSpec): how many parts and how they left through the exit.
+struct FamilyExits {
+  std::string name;  ///< PartSpec::name
+  Shape::Kind shape = Shape::Kind::Box;
+  int spawned = 0;               ///< parts of this family spawned during the run
+  int exited = 0;                ///< crossed the exit plane
+  int removed_without_exit = 0;  ///< taken out of the simulation before the exit (RunHealth)
+  /// Exit orientation histogram, indexed by UpAxis: the body axis pointing up at the crossing.
+  std::array<int, kUpAxisCount> up_axis{};
+  /// False for spheres: a sphere has no distinguishable axis, the histogram then only records
+  /// the body frame of an otherwise symmetric part (still counted).
+  bool orientation_meaningful = true;
+};
+
+/// The numbers a feeder is judged by (times from the start of the run).
+struct FeederMetrics {
+  bool exit_plane = false;  ///< the scene has an exit plane (Outputs::exit_plane)
+  Vec3 up{0, 0, 1};         ///< upDirection of the scene's gravity (unit, world)
+  /// Time of each crossing of the exit plane (s), ascending: linear interpolation of the
+  /// signed distance to the plane between the two steps around the crossing.
+  std::vector<double> exit_times;
+  /// The first crossing (s); NaN when no part crossed (see `note`).
+  double first_exit_time = std::numeric_limits<double>::quiet_NaN();
+  /// Mean output rate from the first to the last exit: (n - 1) / (t_last - t_first) x 60
+  /// (parts per minute); NaN with fewer than two exits or all at one time.
+  double mean_rate_per_min = std::numeric_limits<double>::quiet_NaN();
+  double rate_window = 0;        ///< width of the rate windows (s), exitRateWindow
+  std::vector<RateWindow> rate;  ///< output rate and cumulative count over the run
+  /// Parts spawned on the exit side of the plane: never counted as exits (said on stderr).
+  int spawned_beyond_exit = 0;
+  std::vector<FamilyExits> families;  ///< one per Scene::parts entry, same order
+  /// Empty, or why a number is missing: "no part reached the exit in 3 s", "the scene has no
+  /// exit plane (outputs.exit_plane is false): no exit metrics".
+  std::string note;
 };
 
 /// The result of one run.
@@ -55,12 +138,16 @@ struct RunMetrics {
   /// The scene check's warnings before the run (check.hpp: kind, values, safe setting), one
   /// formatted line each; also printed on stderr when the run starts.
   std::vector<std::string> scene_check;
+  /// Output rate, first exit, exit orientation per family.
+  FeederMetrics feeder;
 };
 
 /// Progress report: fraction done in [0, 1].
 using Progress = std::function<void(double fraction)>;
 
-/// Runs `scene` with `method` for its duration and measures it. Before the first step the scene
+/// Runs `scene` with `method` for its duration and measures it (drift, health, and with an exit
+/// plane the FeederMetrics; a run with an exit plane that no part reached says so on stderr).
+/// Before the first step the scene
 /// check (checkScene) runs and its warnings go to stderr and into RunMetrics::scene_check.
 /// `progress` (optional) is called about a hundred times. Throws std::invalid_argument for an
 /// invalid scene. When the run lost parts, had reference steps it cannot trust or ignored settings
@@ -77,17 +164,19 @@ double studentT95(int dof);
 /// parts lost so far by kind (cumulative counts, RunHealth): lost_fell,lost_through_fixture,
 /// lost_out_of_bounds,lost_nonfinite,lost_too_fast.
 std::string seriesCsv(const RunMetrics& run);
-/// One-line JSON summary of a run: all scalar fields and a "health" object with every count of
+/// One-line JSON summary of a run: all scalar fields, a "health" object with every count of
 /// RunHealth, parts_lost, the share of Coulomb fallback steps, the maximum part speed and its
-/// bound, and the list of ignored settings.
+/// bound, and the list of ignored settings, and a "feeder" object (feederJson, output.hpp).
 std::string summaryJson(const RunMetrics& run);
 /// One line naming what a run lost, could not trust or ignored, e.g. "3 of 60 parts lost
 /// (fell 2, through a fixture 1); ..."; "nothing lost" when RunHealth::anything() is false.
 std::string healthSummary(const RunHealth& health, int parts);
 
 /// Writes <stem>.csv, <stem>.json and, when gnuplot is available, <stem>.png (mean drift vs time
-/// with the 95 % band) into `folder`, each atomically. Returns the paths written; a missing
-/// gnuplot is reported on stderr and the PNG skipped.
+/// with the 95 % band) into `folder`, each atomically; with an exit plane also the feeder
+/// outputs (writeFeederOutputs, output.hpp: <stem>_exits.csv, <stem>_orientation.csv and their
+/// plots). Returns the paths written; a missing gnuplot is reported on stderr and the PNGs
+/// skipped.
 std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::string& folder,
                                          const std::string& stem);
 
