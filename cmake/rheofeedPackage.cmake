@@ -40,6 +40,18 @@ function(rheofeed_package_component name)
                           "cmake/rheofeedConfig.cmake.in (known: ${RHEOFEED_PACKAGE_KNOWN_PACKAGES})")
     endif()
   endforeach()
+  # Shared libraries find the ones they link beside themselves, wherever the prefix is.
+  foreach(t IN LISTS arg_TARGETS)
+    get_target_property(type ${t} TYPE)
+    get_target_property(rpath ${t} INSTALL_RPATH)
+    if(type STREQUAL "SHARED_LIBRARY" AND NOT rpath)
+      if(APPLE)
+        set_target_properties(${t} PROPERTIES INSTALL_RPATH "@loader_path")
+      elseif(UNIX)
+        set_target_properties(${t} PROPERTIES INSTALL_RPATH "$ORIGIN")
+      endif()
+    endif()
+  endforeach()
   install(TARGETS ${arg_TARGETS}
     EXPORT rheofeed_${name}_targets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
