@@ -1,29 +1,64 @@
 # SPDX-License-Identifier: MIT
-# Wraps Debian's ODE (libode-dev ships pkg-config metadata only, no CMake package)
-# in the imported target ODE::ODE and refuses a single-precision build.
-include_guard(GLOBAL)
+# Wraps Debian's ODE (libode-dev ships pkg-config metadata only, no CMake package) in the
+# imported target ODE::ODE and refuses a single-precision build.
+#
+# Used by rheofeed's own build and by the installed rheofeedConfig.cmake, so it must work in any
+# consumer project: C only, C++ only, or both (the precision probe is compiled in whichever of
+# the two is enabled). Sets RHEOFEED_ODE_FOUND and, when false, RHEOFEED_ODE_NOT_FOUND_MESSAGE.
+# A failure is fatal unless RHEOFEED_ODE_OPTIONAL is set (the package config sets it and reports
+# the message through find_package). Safe to include more than once.
 
-find_package(PkgConfig REQUIRED)
-pkg_check_modules(RHEOFEED_ODE_PC REQUIRED IMPORTED_TARGET GLOBAL ode)
+function(_rheofeed_wrap_ode)
+  set(RHEOFEED_ODE_FOUND FALSE PARENT_SCOPE)
+  if(NOT TARGET ODE::ODE)
+    find_package(PkgConfig QUIET)
+    if(NOT PKG_CONFIG_FOUND)
+      set(RHEOFEED_ODE_NOT_FOUND_MESSAGE
+          "rheofeed finds ODE through pkg-config (Debian's libode-dev ships ode.pc only), but "
+          "pkg-config was not found: install pkg-config." PARENT_SCOPE)
+      return()
+    endif()
+    pkg_check_modules(RHEOFEED_ODE_PC QUIET IMPORTED_TARGET GLOBAL ode)
+    if(NOT RHEOFEED_ODE_PC_FOUND)
+      set(RHEOFEED_ODE_NOT_FOUND_MESSAGE
+          "rheofeed needs ODE: pkg-config found no module 'ode' (PKG_CONFIG_PATH: "
+          "'$ENV{PKG_CONFIG_PATH}'). Install Debian's libode-dev." PARENT_SCOPE)
+      return()
+    endif()
+    pkg_get_variable(precision ode precision)
+    if(precision AND NOT precision STREQUAL "dDOUBLE")
+      set(RHEOFEED_ODE_NOT_FOUND_MESSAGE
+          "rheofeed needs ODE built in double precision; pkg-config 'ode' says "
+          "precision=${precision} (must be dDOUBLE). Install Debian's libode-dev (double "
+          "precision) or rebuild ODE with -DODE_DOUBLE_PRECISION=ON." PARENT_SCOPE)
+      return()
+    endif()
+    add_library(ODE::ODE INTERFACE IMPORTED GLOBAL)
+    target_link_libraries(ODE::ODE INTERFACE PkgConfig::RHEOFEED_ODE_PC)
+  endif()
 
-if(NOT TARGET ODE::ODE)
-  add_library(ODE::ODE INTERFACE IMPORTED GLOBAL)
-  target_link_libraries(ODE::ODE INTERFACE PkgConfig::RHEOFEED_ODE_PC)
-endif()
-
-# Configure-time precision check: the headers must select dDOUBLE, the
-# pkg-config file must say so, and the library itself must report
-# "ODE_double_precision" from dCheckConfiguration().
-pkg_get_variable(RHEOFEED_ODE_PRECISION ode precision)
-if(RHEOFEED_ODE_PRECISION AND NOT RHEOFEED_ODE_PRECISION STREQUAL "dDOUBLE")
-  message(FATAL_ERROR
-    "rheofeed needs ODE built in double precision; pkg-config 'ode' says precision=${RHEOFEED_ODE_PRECISION}. "
-    "Install Debian's libode-dev (double precision) or rebuild ODE with -DODE_DOUBLE_PRECISION=ON.")
-endif()
-
-if(NOT DEFINED RHEOFEED_ODE_IS_DOUBLE)
-  set(_probe_dir "${CMAKE_BINARY_DIR}/CMakeFiles/rheofeed_ode_probe")
-  file(WRITE "${_probe_dir}/probe.c" [=[
+  # Configure-time precision check: the headers must select dDOUBLE and the library itself must
+  # report "ODE_double_precision" from dCheckConfiguration(). The same source is valid C and
+  # C++, so it is compiled as whichever language the project enabled.
+  if(RHEOFEED_ODE_IS_DOUBLE)
+    set(RHEOFEED_ODE_FOUND TRUE PARENT_SCOPE)
+    return()
+  endif()
+  get_property(languages GLOBAL PROPERTY ENABLED_LANGUAGES)
+  if("C" IN_LIST languages)
+    set(ext c)
+  elseif("CXX" IN_LIST languages)
+    set(ext cpp)
+  else()
+    # Nothing here can compile against ODE, so nothing can be built wrongly: say so, do not
+    # cache, and probe again once a language is enabled.
+    message(STATUS "rheofeed: neither C nor C++ is enabled (languages: '${languages}'); the "
+                   "ODE precision probe is skipped")
+    set(RHEOFEED_ODE_FOUND TRUE PARENT_SCOPE)
+    return()
+  endif()
+  set(probe_dir "${CMAKE_BINARY_DIR}/CMakeFiles/rheofeed_ode_probe")
+  file(WRITE "${probe_dir}/probe.${ext}" [=[
 #include <ode/ode.h>
 #include <stdio.h>
 #ifndef dDOUBLE
@@ -37,20 +72,40 @@ int main(void) {
   return ok ? 0 : 1;
 }
 ]=])
-  try_run(_run_result _compile_result
-    "${_probe_dir}/build" "${_probe_dir}/probe.c"
-    LINK_LIBRARIES PkgConfig::RHEOFEED_ODE_PC
-    COMPILE_OUTPUT_VARIABLE _compile_out
-    RUN_OUTPUT_VARIABLE _run_out)
-  if(NOT _compile_result)
-    message(FATAL_ERROR "rheofeed: could not build a program against ODE:\n${_compile_out}")
+  if(CMAKE_CROSSCOMPILING AND NOT CMAKE_CROSSCOMPILING_EMULATOR)
+    # The probe cannot run here: the header check (dDOUBLE) is all that can be done.
+    try_compile(compiled "${probe_dir}/build" "${probe_dir}/probe.${ext}"
+                LINK_LIBRARIES ODE::ODE OUTPUT_VARIABLE compile_out)
+    set(run_result 0)
+    set(run_out "not run (cross-compiling without CMAKE_CROSSCOMPILING_EMULATOR)")
+  else()
+    try_run(run_result compiled "${probe_dir}/build" "${probe_dir}/probe.${ext}"
+            LINK_LIBRARIES ODE::ODE
+            COMPILE_OUTPUT_VARIABLE compile_out RUN_OUTPUT_VARIABLE run_out)
   endif()
-  if(NOT _run_result EQUAL 0)
-    message(FATAL_ERROR
-      "rheofeed needs ODE in double precision, but dCheckConfiguration(\"ODE_double_precision\") "
-      "is false for the installed library (configuration: ${_run_out})")
+  if(NOT compiled)
+    set(RHEOFEED_ODE_NOT_FOUND_MESSAGE
+        "rheofeed: could not build a ${ext} program against ODE (probe ${probe_dir}/probe.${ext})"
+        ":\n${compile_out}" PARENT_SCOPE)
+    return()
   endif()
-  string(STRIP "${_run_out}" _run_out)
-  message(STATUS "ODE ${RHEOFEED_ODE_PC_VERSION}: ${_run_out}")
+  if(NOT run_result EQUAL 0)
+    set(RHEOFEED_ODE_NOT_FOUND_MESSAGE
+        "rheofeed needs ODE in double precision, but dCheckConfiguration(\"ODE_double_precision\")"
+        " is false for the installed library (exit code ${run_result}, configuration: "
+        "${run_out})" PARENT_SCOPE)
+    return()
+  endif()
+  string(STRIP "${run_out}" run_out)
+  if(NOT rheofeed_FIND_QUIETLY)
+    message(STATUS "ODE ${RHEOFEED_ODE_PC_VERSION}: ${run_out}")
+  endif()
   set(RHEOFEED_ODE_IS_DOUBLE TRUE CACHE INTERNAL "ODE reports double precision")
+  set(RHEOFEED_ODE_FOUND TRUE PARENT_SCOPE)
+endfunction()
+
+set(RHEOFEED_ODE_NOT_FOUND_MESSAGE "")
+_rheofeed_wrap_ode()
+if(NOT RHEOFEED_ODE_FOUND AND NOT RHEOFEED_ODE_OPTIONAL)
+  message(FATAL_ERROR "${RHEOFEED_ODE_NOT_FOUND_MESSAGE}")
 endif()
