@@ -20,7 +20,7 @@ include(GNUInstallDirs)
 set(RHEOFEED_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/rheofeed)
 set(RHEOFEED_PACKAGE_TABLE "")
 set(RHEOFEED_PACKAGE_COMPONENTS "")
-set(RHEOFEED_PACKAGE_KNOWN_PACKAGES ODE Eigen3 nlohmann_json assimp)
+set(RHEOFEED_PACKAGE_KNOWN_PACKAGES ODE Eigen3 nlohmann_json assimp TinyGLTF)
 
 function(rheofeed_package_component name)
   cmake_parse_arguments(PARSE_ARGV 1 arg "" "" "TARGETS;COMPONENTS;PACKAGES")

@@ -2,14 +2,17 @@
 #include "demo_runner.hpp"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
 #include <vector>
 
+#include "rheofeed/scene/animation.hpp"
 #include "rheofeed/scene/calibration.hpp"
 #include "rheofeed/scene/metrics.hpp"
 #include "rheofeed/scene/plot.hpp"
@@ -41,7 +44,7 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
   std::string scene_file, out_dir = "out/" + name;
   double duration = 0, dt = 0;
   std::vector<std::string> methods = {"ode_rheonomic"};
-  bool classical = false;
+  bool classical = false, animation = false;
   CLI::App app{description};
   app.add_option("--scene", scene_file,
                  "scene file (JSON, a regular file) instead of the built-in scene");
@@ -66,6 +69,9 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
   app.add_flag("--classical", classical,
                "calibrate a vibration with the classical single-part model (quick estimate) "
                "instead of a full-vibration sample run");
+  app.add_flag("--animation", animation,
+               "also write an animation of the FIRST method's run: <method>.glb (glTF 2.0, opens "
+               "in Blender) and view.html, which plays it in a browser with the plots");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -196,8 +202,13 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
       s.outputs.sample_interval = runs[k].first.outputs.sample_interval;
       std::fprintf(stderr, "%s: %s runs at h = %s s (%s)\n", name.c_str(), toString(m),
                    number(s.solver.time_step).c_str(), runs[k].second.source.c_str());
-      const RunMetrics r = measureRun(s, m, stderrProgress(name + " " + toString(m)));
+      std::unique_ptr<AnimationRecorder> recorder;
+      if (animation && k == 0) recorder = std::make_unique<AnimationRecorder>(s, m);
+      const RunMetrics r =
+          measureRun(s, m, stderrProgress(name + " " + toString(m)), recorder.get());
       writeRunOutputs(r, out_dir, toString(m));
+      if (recorder)
+        recorder->write(std::filesystem::path(out_dir) / (toString(m) + std::string(".glb")));
       blocks.emplace_back(toString(m), seriesCsv(r));
       // Lost parts and fallback steps (RunHealth): the kinds are in the JSON output and the
       // stderr summary of measureRun.
@@ -229,6 +240,16 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
               " using 1:(1000 * $5) with lines lw 2 title '" + blocks[k].first + "'";
       }
       plotPng(gp, blocks, (std::filesystem::path(out_dir) / "mean_height.png").string());
+    }
+    if (animation && !chosen.empty()) {  // the page shows every plot of the folder
+      std::vector<std::string> plots;
+      for (const auto& entry : std::filesystem::directory_iterator(out_dir)) {
+        if (entry.path().extension() == ".png") plots.push_back(entry.path().filename().string());
+      }
+      std::sort(plots.begin(), plots.end());
+      const std::filesystem::path page =
+          writeViewer(out_dir, toString(chosen[0]) + std::string(".glb"), plots);
+      std::printf("\nanimation: open %s\n", page.string().c_str());
     }
     std::printf("\noutputs in %s/\n", out_dir.c_str());
   } catch (const std::exception& e) {

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "rheofeed/scene/animation.hpp"
 #include "rheofeed/scene/check.hpp"
 #include "rheofeed/scene/output.hpp"
 #include "rheofeed/scene/plot.hpp"
@@ -168,7 +169,8 @@ std::vector<int> partFamilies(const Scene& scene) {
   return family;
 }
 
-RunMetrics measureRun(const Scene& scene, Method method, const Progress& progress) {
+RunMetrics measureRun(const Scene& scene, Method method, const Progress& progress,
+                      AnimationRecorder* animation) {
   std::unique_ptr<Simulation> sim = makeSimulation(scene, method);
   const double h = scene.solver.time_step;
   const Outputs& out = scene.outputs;
@@ -310,9 +312,11 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
 
   const std::clock_t cpu_start = std::clock();
   observe(0.0, false);
+  if (animation) animation->record(*sim);
   for (long k = 1; k <= steps; ++k) {
     sim->step();
     observe(sim->time(), k % every == 0);
+    if (animation && (k % every == 0 || k == steps)) animation->record(*sim);
     if (progress && k % report_every == 0) progress(double(k) / steps);
   }
   m.cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;

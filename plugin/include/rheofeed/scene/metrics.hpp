@@ -142,6 +142,8 @@ struct RunMetrics {
   FeederMetrics feeder;
 };
 
+class AnimationRecorder;  // animation.hpp
+
 /// Progress report: fraction done in [0, 1].
 using Progress = std::function<void(double fraction)>;
 
@@ -152,7 +154,10 @@ using Progress = std::function<void(double fraction)>;
 /// `progress` (optional) is called about a hundred times. Throws std::invalid_argument for an
 /// invalid scene. When the run lost parts, had reference steps it cannot trust or ignored settings
 /// (RunHealth::anything), one summary line is printed on stderr at the end (healthSummary).
-RunMetrics measureRun(const Scene& scene, Method method, const Progress& progress = {});
+/// `animation` (optional, built from the same scene and method) records the run at t = 0, at
+/// every metric sample and at the end; the caller writes it (AnimationRecorder::write).
+RunMetrics measureRun(const Scene& scene, Method method, const Progress& progress = {},
+                      AnimationRecorder* animation = nullptr);
 
 /// A progress printer for stderr: "label: 42 %" on one refreshed line, at most every 0.5 s.
 Progress stderrProgress(const std::string& label);
