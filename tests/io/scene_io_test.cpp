@@ -232,7 +232,7 @@ Scene everyFieldScene() {
   v.axis_direction = {0, 0, 1};
   bowl.law.has_calibrated_drift = true;
   bowl.law.calibrated_drift = {{0, 0, 0.0019}, {0, 0, 0.4}, {-3, 0, 0}};
-  bowl.law.drift_model = DriftModel::LocalSampled;  // the calibrated drift kept beside it
+  bowl.law.drift_model = DriftModel::LocalSampled;            // the calibrated drift kept beside it
   bowl.law.efficiency = {0.8123456789012345, 1, 1.0 / 3, 0};  // boxes, balls, pins, nuts
   s.fixtures.push_back(bowl);
 
@@ -635,25 +635,22 @@ TEST(SceneFileErrors, BadDriftModelAndEfficiencyAreExplained) {
   const std::string sampled = R"("drift_model": "local_sampled", "efficiency": )";
   refused(withLaw(sampled + "[1, 1]"), "fixtures[0].law.efficiency",
           "one per part family (3, in the order of parts), got an array of 2");
-  refused(withLaw(sampled + "[1, 200, 1]"), "fixtures[0].law.efficiency[1]",
-          "must be in [0, 100]");
+  refused(withLaw(sampled + "[1, 200, 1]"), "fixtures[0].law.efficiency[1]", "must be in [0, 100]");
   refused(withLaw(sampled + "[1, -0.5, 1]"), "fixtures[0].law.efficiency[1]", "must be >= 0");
-  refused(withLaw(sampled + "[1, \"x\", 1]"), "fixtures[0].law.efficiency[1]",
-          "expected a number");
+  refused(withLaw(sampled + "[1, \"x\", 1]"), "fixtures[0].law.efficiency[1]", "expected a number");
   refused(withLaw(sampled + "0.8"), "fixtures[0].law.efficiency",
           "expected {\"<part family name>\": factor, ...} or an array");
   // kGood's families are all named "parts" (the default): a name cannot pick one.
   refused(withLaw(sampled + R"({"parts": 0.8})"), "fixtures[0].law.efficiency.parts",
           "parts[0] and parts[1] are both named \"parts\"");
-  const std::string named = replaced(kGood, R"({"shape": "sphere")",
-                                     R"({"name": "balls", "shape": "sphere")");
+  const std::string named =
+      replaced(kGood, R"({"shape": "sphere")", R"({"name": "balls", "shape": "sphere")");
   refused(replaced(named, law, R"("angle_deg": 20}, )" + sampled + R"({"ball": 0.8}})"),
           "fixtures[0].law.efficiency.ball", "no part family is named \"ball\" (did you mean");
   refused(replaced(named, law, R"("angle_deg": 20}, )" + sampled + R"({"balls": 1e3}})"),
           "fixtures[0].law.efficiency.balls", "must be in [0, 100]");
-  EXPECT_NO_THROW(
-      parseScene(replaced(named, law, R"("angle_deg": 20}, )" + sampled + R"({"balls": 0.8}})"),
-                 "good.json"));
+  EXPECT_NO_THROW(parseScene(
+      replaced(named, law, R"("angle_deg": 20}, )" + sampled + R"({"balls": 0.8}})"), "good.json"));
   refused(
       replaced(kGood,
                R"("law": {"vibration": {"amplitude": 2e-4, "frequency": 50, "angle_deg": 20}})",
