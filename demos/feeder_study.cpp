@@ -13,6 +13,13 @@
 //   feeder_study [--scene track|trough|heap|hopper|FILE.json] [--out out/study] [--seeds 3]
 //   [--quick]
 //                [--rtf-parts 500]
+//
+// With --drift-models it instead compares the four drift models of a rheonomic run (the local
+// vibration law, the local law with a sampled efficiency, the sampled constant, the classical
+// constant) against full vibration on the study's scenes (study/drift_models.hpp):
+//
+//   feeder_study --drift-models [--out demos/results] [--only track_level,hopper,...]
+//                [--ref-steps-per-cycle 1000] [--quick]
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -28,6 +35,7 @@
 #include "rheofeed/scene/output.hpp"
 #include "rheofeed/scene/plot.hpp"
 #include "rheofeed/scene/scene_io.hpp"
+#include "study/drift_models.hpp"
 
 namespace {
 
@@ -68,7 +76,27 @@ int main(int argc, char** argv) {
   app.add_option("--rtf-parts", rtf_parts,
                  "also measure the real-time factor of the rheonomic ODE run with this many "
                  "parts (trough scene)");
+  bool drift_models = false;
+  rheofeed::demo::DriftModelStudyOptions dm;
+  app.add_flag("--drift-models", drift_models,
+               "compare the drift models (local, local + sampled efficiency, sampled constant, "
+               "classical constant) against full vibration on the study's scenes; writes "
+               "drift_models.{csv,md,png} into --out");
+  app.add_option("--only", dm.scenes, "--drift-models: only these scenes")
+      ->delimiter(',')
+      ->check(CLI::IsMember(rheofeed::demo::driftModelStudyScenes()));
+  app.add_option("--ref-steps-per-cycle", dm.reference_steps_per_cycle,
+                 "--drift-models: steps per vibration cycle of the full-vibration judge")
+      ->capture_default_str()
+      ->check(CLI::Range(100, 100000));
+  app.add_option("--bowl-scene", dm.bowl_scene, "--drift-models: the bowl's scene file")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (drift_models) {
+    dm.out_dir = out_dir;
+    dm.quick = quick;
+    return rheofeed::demo::runDriftModelStudy(dm);
+  }
 
   try {
     Scene scene = scene_arg == "track"    ? vibratingTrackScene()
