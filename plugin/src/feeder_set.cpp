@@ -415,8 +415,10 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
             // g1), the contact's mu and the part's own efficiency.
             const bool feeder_is_g1 = f == f1;
             const dBodyID part = feeder_is_g1 ? bodyOf(g2) : bodyOf(g1);
-            value =
-                law.contactVelocity(p, feeder_is_g1 ? -n : n, c.surface.mu, s.partEfficiency(part));
+            Vec3 centre;  // the part's centre of mass (StepLaw::contactVelocity)
+            if (part) centre = toVec3(dBodyGetPosition(part));
+            value = law.contactVelocity(p, feeder_is_g1 ? -n : n, c.surface.mu,
+                                        s.partEfficiency(part), part ? &centre : nullptr);
           } else {
             value = law.tangentialVelocity(p, n);
           }

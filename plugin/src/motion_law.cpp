@@ -491,9 +491,10 @@ Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n) const {
   return {};
 }
 
-Vec3 StepLaw::contactVelocity(const Vec3& p, const Vec3& n_out, double mu,
-                              double efficiency) const {
-  if (eval_ != Eval::Local) return tangentialVelocity(p, n_out);
+Vec3 StepLaw::contactVelocity(const Vec3& p_contact, const Vec3& n_out, double mu,
+                              double efficiency, const Vec3* carried) const {
+  const Vec3 p = carried ? *carried - dot(*carried - p_contact, n_out) * n_out : p_contact;
+  if (eval_ != Eval::Local) return tangentialVelocity(p_contact, n_out);
   if (local_->isTranslation()) {
     if (!(memo_valid_ && n_out == memo_n_ && mu == memo_mu_)) {
       memo_value_ = localDrift(*local_, p, n_out, mu, table_, &memo_wall_);

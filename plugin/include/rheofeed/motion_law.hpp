@@ -263,8 +263,14 @@ class StepLaw {
   /// Local vibration law: the drift c_t (m/s, world) at `p` (m, world) where `n_out` is the unit
   /// normal pointing out of the feeder into the part and `mu` the contact's friction
   /// coefficient; `efficiency` multiplies it (a part family's own factor, 1 = the law's own).
-  /// Any other law: tangentialVelocity(p, n_out).
-  Vec3 contactVelocity(const Vec3& p, const Vec3& n_out, double mu, double efficiency = 1) const;
+  /// With `carried` (the part's centre of mass, m, world) the law is evaluated at the centre's
+  /// projection on the contact plane, q = x_c - ((x_c - p) . n_out) n_out, instead of at p: every
+  /// contact of a part on one face then asks for the same motion (a rigid part cannot follow
+  /// different drifts at its corners; on a bowl ramp the per-corner drifts cost the part 4-8 %
+  /// of its speed, tests/validation/local_drift_test.cpp). Any other law:
+  /// tangentialVelocity(p, n_out).
+  Vec3 contactVelocity(const Vec3& p, const Vec3& n_out, double mu, double efficiency = 1,
+                       const Vec3* carried = nullptr) const;
 
   /// Whether the frozen values are all finite and within the limits (kMaxSurfaceSpeed, ...; a
   /// profile or twist function can fail, or throw).

@@ -281,8 +281,10 @@ struct World::Impl {
     if (it == feeder_index.end()) return Vector3d::Zero();
     const StepLaw& law = feeders[it->second].frozen;
     if (law.needsContactSide()) {
-      const double efficiency = carried == kStatic ? 1.0 : bodies[carried].efficiency;
-      return toEigen(law.contactVelocity(toVec3(p), toVec3(n_out), mu, efficiency));
+      if (carried == kStatic) return toEigen(law.contactVelocity(toVec3(p), toVec3(n_out), mu));
+      const Body& body = bodies[static_cast<std::size_t>(carried)];
+      return toEigen(
+          law.contactVelocity(toVec3(p), toVec3(n_out), mu, body.efficiency, &body.state.position));
     }
     if (carried == kStatic) return toEigen(law.tangentialVelocity(toVec3(p), toVec3(n_out)));
     return toEigen(
