@@ -60,11 +60,13 @@ std::vector<StudyScene> studyScenes(const DriftModelStudyOptions& o) {
   std::vector<StudyScene> list;
   auto track = [&](const std::string& name, const std::string& what, double incline, double cross,
                    bool sideways) {
-    list.push_back({name, what, [=](bool quick) {
+    list.push_back({name, what,
+                    [=](bool quick) {
                       Scene s = tiltedTrack(incline, cross, sideways, quick);
                       s.name = name;
                       return s;
-                    }});
+                    },
+                    cross != 0});
   };
   track("track_level", "one plate, level track (m/s along the track)", 0, 0, false);
   track("track_up5", "one plate, track climbing 5 deg", 5, 0, false);
@@ -204,7 +206,7 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
         Scene s = scene;
         s.solver.time_step = 1.0 / (f * ref_spc);
         r.reference = mean_over_seeds(
-            s, Method::OdeFullVibration,
+            s, judge,
             entry.name + " full vibration " + std::to_string(ref_spc) + " steps/cycle",
             &r.reference_ci95, &r.reference_cpu, &r.reference_health);
       }
