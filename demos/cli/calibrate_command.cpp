@@ -2,6 +2,7 @@
 // `rheofeed calibrate SCENE --out NEW.json`.
 #include <cstdio>
 #include <exception>
+#include <iterator>
 #include <stdexcept>
 #include <system_error>
 
@@ -20,8 +21,16 @@ namespace {
 std::string relativeTo(const std::string& mesh, const std::filesystem::path& folder) {
   if (mesh.empty()) return mesh;
   std::error_code ec;
-  const std::filesystem::path rel =
-      std::filesystem::relative(mesh, std::filesystem::absolute(folder, ec), ec);
+  const std::filesystem::path base = std::filesystem::absolute(folder, ec);
+  const std::filesystem::path file(mesh);
+  // Only within one top-level folder: "../../../work/x.stl" from /tmp is no better than
+  // /work/x.stl.
+  if (ec || !file.is_absolute() || std::distance(base.begin(), base.end()) < 2 ||
+      std::distance(file.begin(), file.end()) < 2 ||
+      *std::next(base.begin()) != *std::next(file.begin())) {
+    return mesh;
+  }
+  const std::filesystem::path rel = std::filesystem::relative(file, base, ec);
   return ec || rel.empty() ? mesh : rel.generic_string();
 }
 
@@ -78,8 +87,9 @@ int calibrateCommand(const CalibrateArgs& args) {
     const std::string comment =
         "Written by rheofeed calibrate from " + plan.file.string() +
         " (its comments are not copied). " +
-        (report.calibrated > 0 ? "Calibrated: " + report.summary
-                               : std::string("No fixture calibrated: the scene gave them.")) +
+        (report.calibrated > 0
+             ? "Calibrated: " + report.summary.substr(0, report.summary.size() - 1)
+             : std::string("No fixture calibrated: the scene gave them.")) +
         " Re-run the calibration whenever the vibration, the parts or mu change.";
     const std::size_t brace = text.find('{');
     text.insert(brace + 1, "\n  \"comment\": \"" + jsonString(comment) + "\",");
