@@ -16,6 +16,7 @@
 #include "common/study.hpp"
 #include "rheofeed/scene/builtin_scenes.hpp"
 #include "rheofeed/scene/scene_io.hpp"
+#include "study/drift_models.hpp"
 
 int main(int argc, char** argv) {
   using namespace rheofeed::scene;
@@ -36,7 +37,27 @@ int main(int argc, char** argv) {
                  "also measure the real-time factor of the rheonomic ODE run with this many "
                  "parts (trough scene)")
       ->capture_default_str();
+  bool drift_models = false;
+  rheofeed::demo::DriftModelStudyOptions dm;
+  app.add_flag("--drift-models", drift_models,
+               "compare the drift models (local, local + sampled efficiency, sampled constant, "
+               "classical constant) against full vibration on the study's scenes; writes "
+               "drift_models.{csv,md,png} into --out");
+  app.add_option("--only", dm.scenes, "--drift-models: only these scenes")
+      ->delimiter(',')
+      ->check(CLI::IsMember(rheofeed::demo::driftModelStudyScenes()));
+  app.add_option("--ref-steps-per-cycle", dm.reference_steps_per_cycle,
+                 "--drift-models: steps per vibration cycle of the full-vibration judge")
+      ->capture_default_str()
+      ->check(CLI::Range(100, 100000));
+  app.add_option("--bowl-scene", dm.bowl_scene, "--drift-models: the bowl's scene file")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (drift_models) {
+    dm.out_dir = options.out_dir;
+    dm.quick = options.quick;
+    return rheofeed::demo::runDriftModelStudy(dm);
+  }
   try {
     const Scene scene = scene_arg == "track"    ? vibratingTrackScene()
                         : scene_arg == "trough" ? troughScene()

@@ -45,6 +45,7 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
   double duration = 0, dt = 0;
   std::vector<std::string> methods = {"ode_rheonomic"};
   bool classical = false, animation = false;
+  std::string drift_model;
   CLI::App app{description};
   app.add_option("--scene", scene_file,
                  "scene file (JSON, a regular file) instead of the built-in scene");
@@ -72,6 +73,13 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
   app.add_flag("--animation", animation,
                "also write an animation of the FIRST method's run: <method>.glb (glTF 2.0, opens "
                "in Blender) and view.html, which plays it in a browser with the plots");
+  CLI::Option* drift_model_option = app.add_option(
+      "--drift-model", drift_model,
+      "what the rheonomic runs use instead of a feeder's vibration, for every vibrating feeder: "
+      "local (the local vibration law, no calibration), local_sampled (the local law times each "
+      "part family's efficiency, measured by a short sampling run unless the scene gives it), "
+      "calibrated_drift (one constant drift twist, calibrated unless the scene gives it). "
+      "Default: each feeder's drift_model in the scene");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -96,6 +104,19 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
       }
       std::fclose(f);
       std::filesystem::remove(probe, ec);
+    }
+    if (drift_model_option->count() > 0) {
+      DriftModel model = DriftModel::Local;
+      if (!parseDriftModel(drift_model, model)) {
+        throw std::invalid_argument("--drift-model " + drift_model +
+                                    ": unknown drift model; expected local, local_sampled or "
+                                    "calibrated_drift");
+      }
+      for (Fixture& f : scene.fixtures) {
+        if (f.law.kind != FeederLaw::Kind::Vibration || f.law.drift_model == model) continue;
+        f.law.drift_model = model;
+        f.law.efficiency.clear();  // the scene's factors belong to its own local_sampled
+      }
     }
     const bool dt_given = dt_option->count() > 0;
     if (dt_given && (!(dt > 0) || !std::isfinite(dt))) {
@@ -166,25 +187,61 @@ int runDemo(int argc, char** argv, const std::string& name, const std::string& d
       runs.emplace_back(std::move(s), step);
     }
 
-    // A rheonomic run of a vibrating feeder needs its drift field: calibrate it once.
-    bool need_calibration = false;
-    for (Method m : chosen) need_calibration = need_calibration || !isFullVibration(m);
-    for (std::size_t i = 0; i < scene.fixtures.size() && need_calibration; ++i) {
-      const FeederLaw& law = scene.fixtures[i].law;
-      if (law.kind != FeederLaw::Kind::Vibration || law.has_calibrated_drift) continue;
-      std::fprintf(stderr, "%s: calibrating fixture '%s' (%s)...\n", name.c_str(),
-                   scene.fixtures[i].name.c_str(),
-                   classical ? "classical model" : "short full-vibration sample run");
-      const Calibration c = classical ? calibrateClassical(scene, static_cast<int>(i))
-                                      : calibrateBySampling(scene, static_cast<int>(i));
-      if (law.vibration.torsion_amplitude > 0) {
-        std::fprintf(stderr, "%s: angular drift %.5g +- %.2g rad/s, %.1f s CPU\n", name.c_str(),
-                     c.value, c.ci95, c.cpu_seconds);
+    // A rheonomic run of a vibrating feeder uses its drift model (scene.hpp DriftModel): the
+    // local law needs nothing; a calibrated drift or local_sampled factors the scene does not
+    // give are measured once, here.
+    bool any_rheonomic_run = false;
+    for (Method m : chosen) any_rheonomic_run = any_rheonomic_run || !isFullVibration(m);
+    for (std::size_t i = 0; i < scene.fixtures.size() && any_rheonomic_run; ++i) {
+      const FeederLaw law = scene.fixtures[i].law;
+      if (law.kind != FeederLaw::Kind::Vibration) continue;
+      const int fixture = static_cast<int>(i);
+      const char* fixture_name = scene.fixtures[i].name.c_str();
+      if (law.drift_model == DriftModel::Local) {
+        std::fprintf(stderr, "%s: fixture '%s': drift model local (the local vibration law)\n",
+                     name.c_str(), fixture_name);
+      } else if (law.drift_model == DriftModel::CalibratedDrift && law.has_calibrated_drift) {
+        std::fprintf(stderr, "%s: fixture '%s': drift model calibrated_drift (from the scene)\n",
+                     name.c_str(), fixture_name);
+      } else if (law.drift_model == DriftModel::CalibratedDrift) {
+        std::fprintf(stderr, "%s: calibrating fixture '%s' (%s)...\n", name.c_str(), fixture_name,
+                     classical ? "classical model" : "short full-vibration sample run");
+        const Calibration c =
+            classical ? calibrateClassical(scene, fixture) : calibrateBySampling(scene, fixture);
+        if (law.vibration.torsion_amplitude > 0) {
+          std::fprintf(stderr, "%s: angular drift %.5g +- %.2g rad/s, %.1f s CPU\n", name.c_str(),
+                       c.value, c.ci95, c.cpu_seconds);
+        } else {
+          std::fprintf(stderr, "%s: drift %.5g +- %.2g m/s (efficiency %.3f), %.1f s CPU\n",
+                       name.c_str(), c.value, c.ci95, c.efficiency, c.cpu_seconds);
+        }
+        scene = withCalibration(scene, c);
+      } else if (!law.efficiency.empty()) {
+        std::fprintf(stderr,
+                     "%s: fixture '%s': drift model local_sampled (factors from the "
+                     "scene)\n",
+                     name.c_str(), fixture_name);
       } else {
-        std::fprintf(stderr, "%s: drift %.5g +- %.2g m/s (efficiency %.3f), %.1f s CPU\n",
-                     name.c_str(), c.value, c.ci95, c.efficiency, c.cpu_seconds);
+        EfficiencySettings settings;
+        settings.rheonomic_time_step = dt_given ? dt : options.rheonomic_time_step;
+        for (std::size_t k = 0; k < scene.parts.size(); ++k) {
+          std::fprintf(stderr,
+                       "%s: calibrating fixture '%s', part family '%s' (the part's own "
+                       "efficiency under the local law: full-vibration sample at %d steps per "
+                       "cycle and the local law)...\n",
+                       name.c_str(), fixture_name, scene.parts[k].name.c_str(),
+                       settings.steps_per_cycle);
+          const EfficiencyCalibration c =
+              calibrateEfficiency(scene, fixture, static_cast<int>(k), settings);
+          std::fprintf(stderr,
+                       "%s: efficiency %.4f +- %.2g (sampled %.5g +- %.2g, local law %.5g +- "
+                       "%.2g %s), %.1f s CPU\n",
+                       name.c_str(), c.efficiency, c.ci95, c.sampled, c.sampled_ci95, c.local,
+                       c.local_ci95, law.vibration.torsion_amplitude > 0 ? "rad/s" : "m/s",
+                       c.cpu_seconds);
+          scene = withEfficiency(scene, c);
+        }
       }
-      scene = withCalibration(scene, c);
     }
 
     const std::string unit = scene.outputs.angular_drift ? "rad/s" : "m/s";

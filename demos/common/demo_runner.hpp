@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Shared command line and run loop of the feeder demos: each demo file builds its scene (or
 // loads one with --scene), and this runs it headless with the chosen methods, calibrating a
-// vibrating feeder first when a rheonomic method needs it, and writes CSV + JSON + PNG outputs.
+// vibrating feeder first when its drift model needs it, and writes CSV + JSON + PNG outputs.
 #pragma once
 
 #include <string>
@@ -19,8 +19,14 @@ struct DemoOptions {
   bool plot_height = false;
 };
 
-/// Parses the demo's command line (--scene, --duration, --dt, --out, --method, --classical),
-/// runs the scene and prints a summary. `--dt` sets the time step of the rheonomic runs only
+/// Parses the demo's command line (--scene, --duration, --dt, --out, --method, --classical,
+/// --drift-model), runs the scene and prints a summary. Rheonomic runs of a vibrating feeder
+/// use its drift model (scene.hpp DriftModel; --drift-model local|local_sampled|
+/// calibrated_drift overrides it for every vibrating feeder): nothing is calibrated for
+/// `local`, nor when the scene gives the calibrated drift or the local_sampled factors;
+/// otherwise they are measured once before the runs (calibrateBySampling or, with --classical,
+/// calibrateClassical; calibrateEfficiency per part family at the rheonomic step) and the time
+/// it took is printed. `--dt` sets the time step of the rheonomic runs only
 /// (full-vibration runs keep the scene's solver.time_step; --dt with only full-vibration
 /// methods is refused), and every run prints its step and where it comes from. Every input is
 /// checked before anything runs or calibrates: the scene file (a regular file), --out (not

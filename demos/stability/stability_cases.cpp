@@ -206,6 +206,7 @@ class Builder {
       try {
         s = withCalibration(s, calibrateClassical(s, static_cast<int>(f)));
       } catch (const std::exception& e) {
+        s.fixtures[f].law.drift_model = DriftModel::CalibratedDrift;
         s.fixtures[f].law.has_calibrated_drift = true;
         s.fixtures[f].law.calibrated_drift = {};
         c_.note += (c_.note.empty() ? "" : "; ") + std::string("classical calibration refused (") +

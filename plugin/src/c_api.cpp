@@ -71,6 +71,27 @@ MotionLaw beltLaw(const double* direction, double speed, int frame) {
   return MotionLaw::belt(vec(direction), speed, frameOf(frame));
 }
 
+MotionLaw localVibrationLaw(double frequency, const double* amplitude, double torsion_amplitude,
+                            const double* axis_origin, const double* axis_direction,
+                            const double* gravity, double efficiency) {
+  requireVector(amplitude, "amplitude");
+  requireVector(gravity, "gravity");
+  if (torsion_amplitude != 0) {
+    requireVector(axis_origin, "axis_origin (a torsion needs its axis)");
+    requireVector(axis_direction, "axis_direction (a torsion needs its axis)");
+  }
+  rheofeed::LocalVibration v;
+  v.frequency = frequency;
+  v.amplitude = vec(amplitude);
+  v.torsion_amplitude = torsion_amplitude;
+  if (axis_origin) v.axis_origin = vec(axis_origin);
+  if (axis_direction) v.axis_direction = vec(axis_direction);
+  v.gravity = vec(gravity);
+  v.efficiency = efficiency;
+  v.validate("local vibration");
+  return MotionLaw::localVibration(v);
+}
+
 }  // namespace
 
 extern "C" {
@@ -119,6 +140,36 @@ int rfFeederSetAddField(rfFeederSetID set, dGeomID geom, rfFieldFunction* field,
       return Vec3{out[0], out[1], out[2]};
     };
     set->set.add(geom, MotionLaw::field(wrapped, time_varying != 0));
+  });
+}
+
+int rfFeederSetAddLocalVibration(rfFeederSetID set, dGeomID geom, double frequency,
+                                 const double amplitude[3], double torsion_amplitude,
+                                 const double axis_origin[3], const double axis_direction[3],
+                                 const double gravity[3], double efficiency) {
+  return guarded(set, [&] {
+    set->set.add(geom, localVibrationLaw(frequency, amplitude, torsion_amplitude, axis_origin,
+                                         axis_direction, gravity, efficiency));
+  });
+}
+
+int rfFeederSetSetLocalVibration(rfFeederSetID set, dGeomID geom, double frequency,
+                                 const double amplitude[3], double torsion_amplitude,
+                                 const double axis_origin[3], const double axis_direction[3],
+                                 const double gravity[3], double efficiency) {
+  return guarded(set, [&] {
+    set->set.setLaw(geom, localVibrationLaw(frequency, amplitude, torsion_amplitude, axis_origin,
+                                            axis_direction, gravity, efficiency));
+  });
+}
+
+int rfFeederSetSetPartEfficiency(rfFeederSetID set, dBodyID body, double factor) {
+  return guarded(set, [&] {
+    if (factor == 1.0 && body) {
+      set->set.clearPartEfficiency(body);
+    } else {
+      set->set.setPartEfficiency(body, factor);
+    }
   });
 }
 

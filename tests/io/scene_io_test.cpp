@@ -112,6 +112,8 @@ void expectSameScene(const Scene& a, const Scene& b) {
     expectSame(va.axis_direction, vb.axis_direction, w + ".axis_direction");
     EXPECT_EQ(la.has_calibrated_drift, lb.has_calibrated_drift) << w;
     expectSame(la.calibrated_drift, lb.calibrated_drift, w + ".calibrated_drift");
+    EXPECT_EQ(la.drift_model, lb.drift_model) << w;
+    EXPECT_EQ(la.efficiency, lb.efficiency) << w;  // bit-identical doubles
   }
   ASSERT_EQ(a.parts.size(), b.parts.size());
   for (std::size_t i = 0; i < a.parts.size(); ++i) {
@@ -230,6 +232,8 @@ Scene everyFieldScene() {
   v.axis_direction = {0, 0, 1};
   bowl.law.has_calibrated_drift = true;
   bowl.law.calibrated_drift = {{0, 0, 0.0019}, {0, 0, 0.4}, {-3, 0, 0}};
+  bowl.law.drift_model = DriftModel::LocalSampled;            // the calibrated drift kept beside it
+  bowl.law.efficiency = {0.8123456789012345, 1, 1.0 / 3, 0};  // boxes, balls, pins, nuts
   s.fixtures.push_back(bowl);
 
   Fixture ground;
@@ -390,6 +394,77 @@ TEST(SceneFile, ShorthandsAndAnglesWithUnitsInTheKey) {
 // ---- Refused input -----------------------------------------------------------------------------
 
 // A valid scene; the tests break one value each.
+TEST(SceneFile, DriftModelDefaultsToLocalUnlessTheLawCarriesACalibratedDrift) {
+  const std::string law = R"("law": {"vibration": {"amplitude": 2e-4, "frequency": 50}})";
+  const std::string base = R"({"fixtures": [{"geoms": [{"shape": "box", "size": [1, 0.1, 0.02]}],
+                                LAW}],
+    "parts": [{"shape": "box", "size": [0.02, 0.02, 0.005],
+               "spawn_min": [0, 0, 0.02], "spawn_max": [0, 0, 0.02]}]})";
+  auto with = [&](const std::string& text) {
+    std::string s = base;
+    return s.replace(s.find("LAW"), 3, text);
+  };
+  EXPECT_EQ(parseScene(with(law), "a.json").fixtures[0].law.drift_model, DriftModel::Local);
+  // A file written before the local law (a calibrated drift, no drift_model) behaves as before.
+  const std::string calibrated =
+      R"("law": {"vibration": {"amplitude": 2e-4, "frequency": 50},
+                 "calibrated_drift": {"linear": [0.02, 0, 0]}})";
+  const Scene old = parseScene(with(calibrated), "b.json");
+  EXPECT_EQ(old.fixtures[0].law.drift_model, DriftModel::CalibratedDrift);
+  EXPECT_TRUE(old.fixtures[0].law.has_calibrated_drift);
+  // An explicit model wins; the calibrated drift is kept as an alternative.
+  std::string local = calibrated;
+  local.insert(local.find("\"calibrated_drift\""), R"("drift_model": "local", )");
+  const Scene chosen = parseScene(with(local), "c.json");
+  EXPECT_EQ(chosen.fixtures[0].law.drift_model, DriftModel::Local);
+  EXPECT_TRUE(chosen.fixtures[0].law.has_calibrated_drift);
+  EXPECT_EQ(chosen.fixtures[0].law.calibrated_drift.linear.x, 0.02);
+  // calibrated_drift and local_sampled without their values are valid (the demos calibrate).
+  for (const char* model : {"calibrated_drift", "local_sampled"}) {
+    std::string m = law;
+    m.insert(m.size() - 1, std::string(R"(, "drift_model": ")") + model + "\"");
+    const Scene s = parseScene(with(m), "d.json");
+    EXPECT_EQ(toString(s.fixtures[0].law.drift_model), std::string(model));
+    EXPECT_TRUE(s.fixtures[0].law.efficiency.empty());
+  }
+}
+
+TEST(SceneFile, EfficiencyByPartFamilyNameOrAsAnArray) {
+  const std::string base = R"({"fixtures": [{"geoms": [{"shape": "box", "size": [1, 0.1, 0.02]}],
+      "law": {"vibration": {"amplitude": 2e-4, "frequency": 50}, "drift_model": "local_sampled",
+              "efficiency": EFF}}],
+    "parts": [{"name": "nuts", "shape": "box", "size": [0.02, 0.02, 0.005],
+               "spawn_min": [0, 0, 0.02], "spawn_max": [0, 0, 0.02]},
+              {"name": "pins", "shape": "sphere", "size": [0.004],
+               "spawn_min": [0.2, 0, 0.02], "spawn_max": [0.2, 0, 0.02]}]})";
+  auto with = [&](const std::string& text) {
+    std::string s = base;
+    return s.replace(s.find("EFF"), 3, text);
+  };
+  const Scene named = parseScene(with(R"({"pins": 0.75})"), "named.json");
+  EXPECT_EQ(named.fixtures[0].law.drift_model, DriftModel::LocalSampled);
+  EXPECT_EQ(named.fixtures[0].law.efficiency, (std::vector<double>{1.0, 0.75}));  // nuts: 1
+  const Scene array = parseScene(with("[0.5, 2]"), "array.json");
+  EXPECT_EQ(array.fixtures[0].law.efficiency, (std::vector<double>{0.5, 2.0}));
+  // Written by family name (unique names), read back bit-identical.
+  const std::string text = toJson(named);
+  EXPECT_NE(text.find(R"("efficiency": {)"), std::string::npos) << text;
+  const Scene back = parseScene(text, "back.json");
+  EXPECT_EQ(back.fixtures[0].law.efficiency, named.fixtures[0].law.efficiency);
+  EXPECT_EQ(toJson(back), text);
+}
+
+TEST(SceneFile, EfficiencyIsWrittenAsAnArrayWhenFamilyNamesRepeat) {
+  Scene s = everyFieldScene();
+  s.parts[1].name = s.parts[0].name;  // two families named "boxes"
+  CountingLoader meshes;
+  const std::string text = toJson(s);
+  EXPECT_NE(text.find(R"("efficiency": [)"), std::string::npos);
+  const Scene back = parseScene(text, "repeat.json", meshes.loader());
+  expectSameScene(s, back);
+  EXPECT_EQ(toJson(back), text);
+}
+
 const char* kGood = R"({
   "fixtures": [{"name": "track",
                 "geoms": [{"shape": "box", "size": [1, 0.1, 0.02], "position": [0, 0, -0.01]}],
@@ -541,6 +616,46 @@ TEST(SceneFileErrors, BadLawAndShapeNamesAreExplained) {
           "needs an array of 1");
   refused(replaced(kGood, R"("duration": 1)", R"("duration": 1, "format_version": 2)"),
           "format_version", "reads version 1");
+}
+
+TEST(SceneFileErrors, BadDriftModelAndEfficiencyAreExplained) {
+  const std::string law = R"("angle_deg": 20}})";
+  auto withLaw = [&](const std::string& extra) {
+    return replaced(kGood, law, R"("angle_deg": 20}, )" + extra + "}");
+  };
+  refused(withLaw(R"("drift_model": "locale")"), "fixtures[0].law.drift_model",
+          "did you mean \"local\"");
+  refused(withLaw(R"("drift_model": "constant")"), "fixtures[0].law.drift_model",
+          "expected local, local_sampled or calibrated_drift");
+  refused(withLaw(R"("drift_model": 1)"), "fixtures[0].law.drift_model", "expected a string");
+  refused(withLaw(R"("efficiency": [1, 1, 1])"), "fixtures[0].law.efficiency",
+          "local_sampled only; this law's drift_model is local (the default)");
+  refused(withLaw(R"("drift_model": "calibrated_drift", "efficiency": [1, 1, 1])"),
+          "fixtures[0].law.efficiency", "drift_model is calibrated_drift");
+  const std::string sampled = R"("drift_model": "local_sampled", "efficiency": )";
+  refused(withLaw(sampled + "[1, 1]"), "fixtures[0].law.efficiency",
+          "one per part family (3, in the order of parts), got an array of 2");
+  refused(withLaw(sampled + "[1, 200, 1]"), "fixtures[0].law.efficiency[1]", "must be in [0, 100]");
+  refused(withLaw(sampled + "[1, -0.5, 1]"), "fixtures[0].law.efficiency[1]", "must be >= 0");
+  refused(withLaw(sampled + "[1, \"x\", 1]"), "fixtures[0].law.efficiency[1]", "expected a number");
+  refused(withLaw(sampled + "0.8"), "fixtures[0].law.efficiency",
+          "expected {\"<part family name>\": factor, ...} or an array");
+  // kGood's families are all named "parts" (the default): a name cannot pick one.
+  refused(withLaw(sampled + R"({"parts": 0.8})"), "fixtures[0].law.efficiency.parts",
+          "parts[0] and parts[1] are both named \"parts\"");
+  const std::string named =
+      replaced(kGood, R"({"shape": "sphere")", R"({"name": "balls", "shape": "sphere")");
+  refused(replaced(named, law, R"("angle_deg": 20}, )" + sampled + R"({"ball": 0.8}})"),
+          "fixtures[0].law.efficiency.ball", "no part family is named \"ball\" (did you mean");
+  refused(replaced(named, law, R"("angle_deg": 20}, )" + sampled + R"({"balls": 1e3}})"),
+          "fixtures[0].law.efficiency.balls", "must be in [0, 100]");
+  EXPECT_NO_THROW(parseScene(
+      replaced(named, law, R"("angle_deg": 20}, )" + sampled + R"({"balls": 0.8}})"), "good.json"));
+  refused(
+      replaced(kGood,
+               R"("law": {"vibration": {"amplitude": 2e-4, "frequency": 50, "angle_deg": 20}})",
+               R"("law": {"belt": {"direction": [1, 0, 0], "speed": 1}, "drift_model": "local"})"),
+      "fixtures[0].law.drift_model", "only a vibration or screw law");
 }
 
 TEST(SceneFileErrors, PlaneTakesNoPose) {

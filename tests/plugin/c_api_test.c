@@ -2,7 +2,8 @@
 /*
  * The C API (rheofeed.h) used from a C translation unit: create a feeder set, register a belt,
  * drive the contacts dCollide makes, step ODE with them, and check the error codes and
- * messages of bad calls. Returns nonzero if any check fails; every failure is printed.
+ * messages of bad calls; a local vibration law on a plane against the classical model. Returns
+ * nonzero if any check fails; every failure is printed.
  */
 #include <math.h>
 #include <ode/ode.h>
@@ -82,6 +83,152 @@ static void remember(void* user, const char* kind, dGeomID feeder, const char* m
   ++seen->count;
   snprintf(seen->kind, sizeof seen->kind, "%s", kind);
   snprintf(seen->message, sizeof seen->message, "%s", message);
+}
+
+/* ---- The local vibration law from C ------------------------------------------------------ */
+
+#define PI 3.14159265358979323846
+/* The classical straight-track model (Redford & Boothroyd; NOTES section 5), forward sliding
+ * only (normal throw number below 1, above the forward and below the backward onset), on a
+ * horizontal track, vibration angle beta, friction mu, in units of g / w (velocity) and w t
+ * (phase): forward slip starts at sin(phi1) = mu / Q and the slip velocity relative to the
+ * track is u(phi) = P (phi - phi1) - Q (cos(phi) - cos(phi1)), P = -mu,
+ * Q = (A w^2 / g) (cos(beta) + mu sin(beta)), until it returns to 0 at phi2; the part sticks
+ * otherwise. The drift is the mean of u over a cycle. Integrated here by Simpson's rule,
+ * independently of the plugin's point-mass model (vibration_drift.cpp, a Moreau time stepper). */
+static double slideU(double phi, double phi1, double P, double Q) {
+  return P * (phi - phi1) - Q * (cos(phi) - cos(phi1));
+}
+
+static double classicalSlidingDrift(double amplitude, double beta, double mu, double frequency,
+                                    double g) {
+  const double w = 2 * PI * frequency, aw2 = amplitude * w * w / g;
+  const double P = -mu, Q = aw2 * (cos(beta) + mu * sin(beta));
+  const double phi1 = asin(mu / Q);
+  double lo = phi1 + 1e-3, hi = lo, sum, h;
+  int i, n = 20000;
+  while (hi < phi1 + 2 * PI && slideU(hi, phi1, P, Q) > 0) hi += 1e-3;
+  lo = hi - 1e-3;
+  for (i = 0; i < 100; ++i) { /* bisect the root phi2 to rounding */
+    const double mid = 0.5 * (lo + hi);
+    if (slideU(mid, phi1, P, Q) > 0) {
+      lo = mid;
+    } else {
+      hi = mid;
+    }
+  }
+  h = (lo - phi1) / n;
+  sum = slideU(phi1, phi1, P, Q) + slideU(lo, phi1, P, Q);
+  for (i = 1; i < n; ++i) sum += (i % 2 ? 4 : 2) * slideU(phi1 + i * h, phi1, P, Q);
+  return (g / w) * (sum * h / 3) / (2 * PI);
+}
+
+/* Between the plugin's tabulated point-mass drift and the classical model: the point-mass
+ * model's own error is at most 0.6 % of max(|drift|, 2 % of the peak tangential speed) at its
+ * default 16384 steps per cycle (vibration_drift.hpp), and the table interpolates linearly over
+ * a cell 0.025 wide in the normal and 0.05 in the tangential throw number. */
+static const double kLocalDriftTolerance = 0.02; /* relative */
+/* ODE's direct solver (dWorldStep) makes a sticking box move with the contact's motion1 to
+ * its own rounding and the contact's CFM slack (1e-5 by default); a box that just started
+ * also carries a little of its settling. */
+static const double kBoxFollowsTolerance = 0.01; /* relative */
+
+static void localVibrationFromC(void) {
+  const double kBeta = 30 * PI / 180, kMu = 0.5, kF = 50, kG = 9.81;
+  /* normal throw number Gamma = A w^2 sin(beta) / g = 0.3: forward sliding only for mu = 0.5
+   * (onsets 0.224 and 0.406) */
+  const double w = 2 * PI * kF, amplitude = 0.3 * kG / (w * w * sin(kBeta));
+  const double a[3] = {amplitude * cos(kBeta), 0, amplitude * sin(kBeta)};
+  const double gravity[3] = {0, 0, -kG}, origin[3] = {0, 0, 0}, up[3] = {0, 0, 1};
+  const double expected = classicalSlidingDrift(amplitude, kBeta, kMu, kF, kG);
+  dWorldID world = dWorldCreate();
+  dJointGroupID joints = dJointGroupCreate(0);
+  dGeomID plane = dCreatePlane(0, 0, 0, 1, 0), box_geom = dCreateBox(0, 0.02, 0.02, 0.01);
+  dBodyID box = dBodyCreate(world);
+  dMass mass;
+  dContact contacts[8];
+  rfFeederSetID set = rfFeederSetCreate();
+  int n, i, step;
+  const double h = 0.01;
+
+  double driven_speed = 0;
+  /* forward (along the throw's horizontal part), a small fraction of the peak track speed */
+  CHECK(expected > 0 && expected < 0.2 * w * amplitude * cos(kBeta));
+  dWorldSetGravity(world, 0, 0, -kG);
+  dMassSetBoxTotal(&mass, 0.01, 0.02, 0.02, 0.01);
+  dBodySetMass(box, &mass);
+  dBodySetPosition(box, 0, 0, 0.005 - 1e-4);
+  dGeomSetBody(box_geom, box);
+
+  CHECK(rfFeederSetAddLocalVibration(set, plane, kF, a, 0, origin, up, gravity, 1.0) == rfOK);
+  CHECK(strcmp(rfFeederSetGetLastError(set), "") == 0);
+  CHECK(rfFeederSetBeginStepDt(set, 0.0, h) == rfOK);
+  memset(contacts, 0, sizeof contacts);
+  n = dCollide(plane, box_geom, 8, &contacts[0].geom, sizeof(dContact));
+  CHECK(n == 4);
+  for (i = 0; i < n; ++i) contacts[i].surface.mu = kMu;
+  CHECK(rfFeederSetDriveContacts(set, contacts, n) == n);
+  for (i = 0; i < n; ++i) {
+    /* The plane is g1: ODE's joint moves the part relative to g1 by motion1 along fdir1. */
+    CHECK((contacts[i].surface.mode & dContactMotion1) != 0);
+    CHECK_NEAR(contacts[i].fdir1[0], 1.0, ROUND_OFF); /* along the throw's horizontal part */
+    CHECK_NEAR(contacts[i].surface.motion1, expected, kLocalDriftTolerance * expected);
+  }
+  if (n > 0) driven_speed = contacts[0].surface.motion1;
+
+  /* The part's own efficiency scales its drift exactly. */
+  CHECK(rfFeederSetSetPartEfficiency(set, box, 0.5) == rfOK);
+  memset(contacts, 0, sizeof contacts);
+  n = dCollide(plane, box_geom, 8, &contacts[0].geom, sizeof(dContact));
+  for (i = 0; i < n; ++i) contacts[i].surface.mu = kMu;
+  CHECK(rfFeederSetDriveContacts(set, contacts, n) == n);
+  CHECK(n > 0);
+  if (n > 0) CHECK_NEAR(contacts[0].surface.motion1, 0.5 * driven_speed, ROUND_OFF);
+  CHECK(rfFeederSetSetPartEfficiency(set, box, 1.0) == rfOK);
+
+  /* Stepped: the box moves at the driven speed. */
+  for (step = 0; step < 50; ++step) {
+    CHECK(rfFeederSetBeginStepDt(set, step * h, h) == rfOK);
+    memset(contacts, 0, sizeof contacts);
+    n = dCollide(plane, box_geom, 8, &contacts[0].geom, sizeof(dContact));
+    for (i = 0; i < n; ++i) contacts[i].surface.mu = kMu;
+    n = rfFeederSetDriveContacts(set, contacts, n);
+    for (i = 0; i < n; ++i) {
+      dJointID j = dJointCreateContact(world, joints, &contacts[i]);
+      dJointAttach(j, dGeomGetBody(contacts[i].geom.g1), dGeomGetBody(contacts[i].geom.g2));
+    }
+    dWorldStep(world, h);
+    dJointGroupEmpty(joints);
+  }
+  CHECK_NEAR(dBodyGetLinearVel(box)[0], driven_speed, kBoxFollowsTolerance * driven_speed);
+  CHECK_NEAR(dBodyGetLinearVel(box)[1], 0.0, kBoxFollowsTolerance * driven_speed);
+
+  /* Bad values: an error code and a message naming the value. */
+  CHECK(rfFeederSetSetPartEfficiency(set, box, -1.0) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "-1");
+  CHECK(rfFeederSetSetPartEfficiency(set, 0, 0.5) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "null");
+  CHECK(rfFeederSetSetLocalVibration(set, plane, 0.0, a, 0, origin, up, gravity, 1.0) ==
+        rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "frequency = 0");
+  CHECK(rfFeederSetSetLocalVibration(set, plane, kF, a, 0, origin, up, gravity, 500.0) ==
+        rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "500");
+  CHECK(rfFeederSetSetLocalVibration(set, plane, kF, a, 0.01, 0, 0, gravity, 1.0) ==
+        rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "axis_origin");
+  CHECK(rfFeederSetSetLocalVibration(set, plane, kF, 0, 0, origin, up, gravity, 1.0) ==
+        rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "amplitude");
+  CHECK(rfFeederSetAddLocalVibration(set, plane, kF, a, 0, 0, 0, gravity, 1.0) ==
+        rfErrorInvalidArgument); /* registered already */
+  CHECK(rfFeederSetSetLocalVibration(set, plane, kF, a, 0, 0, 0, gravity, 1.0) == rfOK);
+
+  rfFeederSetDestroy(set);
+  dGeomDestroy(box_geom);
+  dGeomDestroy(plane);
+  dJointGroupDestroy(joints);
+  dWorldDestroy(world);
 }
 
 int main(void) {
@@ -345,6 +492,8 @@ int main(void) {
     rfFeederSetDestroy(g2_first);
   }
   rfFeederSetDestroy(0);
+
+  localVibrationFromC();
 
   rfFeederSetDestroy(set);
   dGeomDestroy(table_geom);

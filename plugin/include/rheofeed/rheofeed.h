@@ -80,6 +80,43 @@ int rfFeederSetAddBelt(rfFeederSetID set, dGeomID geom, const double direction[3
 int rfFeederSetAddField(rfFeederSetID set, dGeomID geom, rfFieldFunction* field, void* user,
                         int time_varying);
 
+/** Register `geom` (a stationary feeder, world frame) with the local vibration law
+ *  (vibration_drift.hpp, MotionLaw::localVibration): at each contact the cycle-averaged drift
+ *  of a point mass on the contact plane vibrating with the feeder's real local vibration, for
+ *  the contact's own mu and the normal pointing out of the feeder. The feeder's vibration, as
+ *  in a full-vibration run: its displacement at a point p (m, world) is
+ *      x(t) = (amplitude + torsion_amplitude axis_direction x (p - axis_origin))
+ *             sin(2 pi frequency t)
+ *  (first order in the torsion; the phase does not change a steady drift).
+ *    frequency          f (Hz, in (0, 1e5])
+ *    amplitude          peak translation displacement vector (m, world; |amplitude| <= 1e3)
+ *    torsion_amplitude  peak rotation about the axis (rad, in [0, pi], right-hand rule)
+ *    axis_origin        a point of the torsion axis (m, world; may be null with no torsion)
+ *    axis_direction     unit torsion axis (world; may be null with no torsion: +z)
+ *    gravity            g (m/s^2, world, finite and non-zero, e.g. {0, 0, -9.81})
+ *    efficiency         factor on every drift of this feeder (dimensionless, in [0, 100]; 1 =
+ *                       a point mass); per part use rfFeederSetSetPartEfficiency.
+ *  Drifts are tabulated lazily: the first contacts of a new surface orientation cost
+ *  milliseconds, later ones well under a microsecond. rfErrorInvalidArgument names the bad
+ *  value (nothing is registered). */
+int rfFeederSetAddLocalVibration(rfFeederSetID set, dGeomID geom, double frequency,
+                                 const double amplitude[3], double torsion_amplitude,
+                                 const double axis_origin[3], const double axis_direction[3],
+                                 const double gravity[3], double efficiency);
+/** Replace the law of a registered feeder with a local vibration law (parameters as
+ *  rfFeederSetAddLocalVibration). */
+int rfFeederSetSetLocalVibration(rfFeederSetID set, dGeomID geom, double frequency,
+                                 const double amplitude[3], double torsion_amplitude,
+                                 const double axis_origin[3], const double axis_direction[3],
+                                 const double gravity[3], double efficiency);
+/** The part's own efficiency under local vibration laws (FeederSet::setPartEfficiency): every
+ *  contact of `body` with a local-vibration feeder gets the drift times `factor`
+ *  (dimensionless, in [0, 100]; 1 = the law's own drift), e.g. as measured per part family by
+ *  a sampling run (issue 8). Other laws ignore it. rfErrorInvalidArgument for a null body or a
+ *  factor out of range (the message names it). Call with factor 1 to forget a body before
+ *  destroying it. */
+int rfFeederSetSetPartEfficiency(rfFeederSetID set, dBodyID body, double factor);
+
 /** Replace the law of a registered feeder (same parameters as the Add functions). Sleeping
  *  parts on it are woken at the next collision pass. */
 int rfFeederSetSetTwist(rfFeederSetID set, dGeomID geom, const double linear[3],

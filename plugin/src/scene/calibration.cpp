@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <ctime>
+#include <sstream>
 #include <stdexcept>
 
 #include "rheofeed/scene/classical_model.hpp"
@@ -13,6 +14,42 @@ namespace rheofeed::scene {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// calibrateEfficiency refuses a local drift below this fraction of the peak vibration speed:
+// there the point-mass drift is near a reversal, the ratio amplifies the sample's noise and
+// its sign is arbitrary.
+constexpr double kMinLocalDriftFraction = 0.01;
+
+// The sampling scene of part family `family` on vibrating fixture `fixture`: `parts` parts of
+// that family alone at t = 0, a time step of 1 / (f steps_per_cycle), the drift measured over
+// whole cycles after the warm-up (angular about the axis for a screw). Efficiency factors are
+// dropped (the sample has one family).
+Scene sampleScene(const Scene& scene, int fixture, int family, int parts, int steps_per_cycle,
+                  double warmup_cycles, double measure_cycles) {
+  const Vibration& v = scene.fixtures[static_cast<std::size_t>(fixture)].law.vibration;
+  Scene sample = scene;
+  sample.name = scene.name + "_calibration";
+  sample.parts = {scene.parts[static_cast<std::size_t>(family)]};
+  sample.parts[0].count = std::min(parts, sample.parts[0].count);
+  sample.parts[0].rate = 0;
+  for (Fixture& f : sample.fixtures) f.law.efficiency.clear();
+  sample.solver.time_step = 1.0 / (v.frequency * steps_per_cycle);
+  sample.duration = (warmup_cycles + measure_cycles) / v.frequency;
+  sample.outputs.warmup = warmup_cycles / v.frequency;
+  sample.outputs.sample_interval = 1.0 / v.frequency;
+  sample.outputs.exit_plane = false;
+  if (v.torsion_amplitude != 0) {  // a screw drives parts round its axis: the angular drift
+    sample.outputs.angular_drift = true;
+    sample.outputs.axis_origin = v.axis_origin;
+    sample.outputs.axis_direction = v.axis_direction;
+  }
+  return sample;
+}
+
+std::string show(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
 
 }  // namespace
 
@@ -33,16 +70,9 @@ Calibration calibrateBySampling(const Scene& scene, int fixture,
   const Vibration& v = scene.fixtures[static_cast<std::size_t>(fixture)].law.vibration;
 
   // The sample: the scene's first part family, a few parts at t = 0, small steps.
-  Scene sample = scene;
-  sample.name = scene.name + "_calibration";
-  sample.parts.resize(1);
-  sample.parts[0].count = std::min(settings.sample_parts, scene.parts[0].count);
-  sample.parts[0].rate = 0;
-  sample.solver.time_step = 1.0 / (v.frequency * settings.steps_per_cycle);
-  sample.duration = (settings.warmup_cycles + settings.measure_cycles) / v.frequency;
-  sample.outputs.warmup = settings.warmup_cycles / v.frequency;
-  sample.outputs.sample_interval = 1.0 / v.frequency;
-  sample.outputs.exit_plane = false;
+  const Scene sample =
+      sampleScene(scene, fixture, 0, settings.sample_parts, settings.steps_per_cycle,
+                  settings.warmup_cycles, settings.measure_cycles);
   const Method method =
       settings.use_reference_solver ? Method::ReferenceFullVibration : Method::OdeFullVibration;
 
@@ -53,11 +83,6 @@ Calibration calibrateBySampling(const Scene& scene, int fixture,
           std::to_string(settings.sample_parts) + " parts)";
   const std::clock_t start = std::clock();
   const bool screw = v.torsion_amplitude != 0;
-  if (screw) {  // a screw drives parts round its axis: measure the angular drift
-    sample.outputs.angular_drift = true;
-    sample.outputs.axis_origin = v.axis_origin;
-    sample.outputs.axis_direction = v.axis_direction;
-  }
   const RunMetrics m = measureRun(sample, method);
   c.value = m.mean_drift;
   c.ci95 = m.mean_drift_ci95;
@@ -127,6 +152,105 @@ Scene withCalibration(Scene scene, const Calibration& calibration) {
   FeederLaw& law = scene.fixtures[static_cast<std::size_t>(calibration.fixture)].law;
   law.has_calibrated_drift = true;
   law.calibrated_drift = calibration.drift;
+  law.drift_model = DriftModel::CalibratedDrift;
+  law.efficiency.clear();
+  return scene;
+}
+
+EfficiencyCalibration calibrateEfficiency(const Scene& scene, int fixture, int family,
+                                          const EfficiencySettings& settings) {
+  scene.validate();
+  const std::string where = "calibrateEfficiency: ";
+  if (fixture < 0 || fixture >= static_cast<int>(scene.fixtures.size()) ||
+      scene.fixtures[static_cast<std::size_t>(fixture)].law.kind != FeederLaw::Kind::Vibration) {
+    throw std::invalid_argument(where + "fixtures[" + std::to_string(fixture) +
+                                "] is not a vibrating feeder");
+  }
+  if (family < 0 || family >= static_cast<int>(scene.parts.size())) {
+    throw std::invalid_argument(where + "part family " + std::to_string(family) +
+                                " is not in [0, " + std::to_string(scene.parts.size()) + ")");
+  }
+  if (settings.sample_parts < 1 || settings.steps_per_cycle < 4 || !(settings.warmup_cycles >= 0) ||
+      !(settings.measure_cycles > 0) ||
+      !(settings.rheonomic_time_step >= 1e-6 && settings.rheonomic_time_step <= 1)) {
+    throw std::invalid_argument(
+        where + "settings need sample_parts >= 1 (got " + std::to_string(settings.sample_parts) +
+        "), steps_per_cycle >= 4 (got " + std::to_string(settings.steps_per_cycle) +
+        "), warmup_cycles >= 0 (got " + show(settings.warmup_cycles) +
+        "), measure_cycles > 0 (got " + show(settings.measure_cycles) +
+        "), rheonomic_time_step in [1e-6, 1] s (got " + show(settings.rheonomic_time_step) + ")");
+  }
+  const Vibration& v = scene.fixtures[static_cast<std::size_t>(fixture)].law.vibration;
+  const bool reference = settings.use_reference_solver;
+  const Scene full =
+      sampleScene(scene, fixture, family, settings.sample_parts, settings.steps_per_cycle,
+                  settings.warmup_cycles, settings.measure_cycles);
+  Scene local = full;  // the same sample, stationary feeders with the local law
+  for (Fixture& f : local.fixtures) {
+    if (f.law.kind == FeederLaw::Kind::Vibration) f.law.drift_model = DriftModel::Local;
+  }
+  local.solver.time_step = settings.rheonomic_time_step;
+  local.outputs.sample_interval = std::max(local.outputs.sample_interval, local.solver.time_step);
+
+  EfficiencyCalibration c;
+  c.fixture = fixture;
+  c.family = family;
+  c.how = std::string("full vibration (") + (reference ? "reference" : "ODE") + ", " +
+          std::to_string(settings.steps_per_cycle) + " steps/cycle, " +
+          std::to_string(full.parts[0].count) + " parts of '" + full.parts[0].name +
+          "') / local law (h = " + show(settings.rheonomic_time_step) + " s)";
+  const std::clock_t start = std::clock();
+  const RunMetrics sampled =
+      measureRun(full, reference ? Method::ReferenceFullVibration : Method::OdeFullVibration);
+  const RunMetrics law =
+      measureRun(local, reference ? Method::ReferenceRheonomic : Method::OdeRheonomic);
+  c.cpu_seconds = double(std::clock() - start) / CLOCKS_PER_SEC;
+  c.sampled = sampled.mean_drift;
+  c.sampled_ci95 = sampled.mean_drift_ci95;
+  c.local = law.mean_drift;
+  c.local_ci95 = law.mean_drift_ci95;
+
+  const double w = 2 * kPi * v.frequency;
+  const bool screw = v.torsion_amplitude != 0;
+  const double peak = screw ? w * v.torsion_amplitude : w * v.amplitude;
+  const std::string unit = screw ? " rad/s" : " m/s";
+  const double floor = std::max(c.local_ci95, kMinLocalDriftFraction * peak);
+  if (!(std::abs(c.local) > floor)) {
+    throw std::invalid_argument(
+        where + "fixtures[" + std::to_string(fixture) + "], part family '" + full.parts[0].name +
+        "': the local law's drift " + show(c.local) + " +- " + show(c.local_ci95) + unit +
+        " is too close to zero (must exceed " + show(floor) + unit +
+        ", the larger of its 95 % half-width and 1 % of the peak vibration speed " + show(peak) +
+        unit + ") for the ratio sampled / local (sampled: " + show(c.sampled) + unit +
+        ") to mean anything; use drift_model local or calibrated_drift here");
+  }
+  c.efficiency = c.sampled / c.local;
+  const double rs = c.sampled != 0 ? c.sampled_ci95 / c.sampled : 0;
+  const double rl = c.local_ci95 / c.local;
+  c.ci95 = std::abs(c.efficiency) * std::sqrt(rs * rs + rl * rl);
+  if (!(c.efficiency >= 0 && c.efficiency <= kMaxPartEfficiency)) {
+    throw std::invalid_argument(
+        where + "fixtures[" + std::to_string(fixture) + "], part family '" + full.parts[0].name +
+        "': efficiency = sampled / local = " + show(c.sampled) + " / " + show(c.local) + " = " +
+        show(c.efficiency) + " must be in [0, " + show(kMaxPartEfficiency) +
+        "] (a negative ratio: the sample and the local law drift in opposite directions)");
+  }
+  return c;
+}
+
+Scene withEfficiency(Scene scene, const EfficiencyCalibration& calibration) {
+  if (calibration.fixture < 0 || calibration.fixture >= static_cast<int>(scene.fixtures.size())) {
+    throw std::invalid_argument("withEfficiency: no fixture " +
+                                std::to_string(calibration.fixture));
+  }
+  if (calibration.family < 0 || calibration.family >= static_cast<int>(scene.parts.size())) {
+    throw std::invalid_argument("withEfficiency: no part family " +
+                                std::to_string(calibration.family));
+  }
+  FeederLaw& law = scene.fixtures[static_cast<std::size_t>(calibration.fixture)].law;
+  law.drift_model = DriftModel::LocalSampled;
+  if (law.efficiency.size() != scene.parts.size()) law.efficiency.assign(scene.parts.size(), 1.0);
+  law.efficiency[static_cast<std::size_t>(calibration.family)] = calibration.efficiency;
   return scene;
 }
 

@@ -443,11 +443,18 @@ std::vector<Hazard> checkScene(const Scene& scene, Method method) {
         break;
       case FeederLaw::Kind::Vibration: {
         const Vibration& v = law.vibration;
-        if (full) {
+        if (full || law.drift_model != DriftModel::CalibratedDrift) {
+          // A point mass's cycle-averaged drift stays below the vibration's peak velocity at
+          // its point; the local law multiplies it by the part family's efficiency.
           const double w = 2 * kPi * v.frequency;
           const double r = all.bounded ? radiusFromAxis(all, v.axis_origin, v.axis_direction) : 0;
-          speed = w * v.amplitude + w * v.torsion_amplitude * r;
-          source = idx("fixtures", f) + ".law.vibration (peak velocity 2 pi f (A + theta r))";
+          double factor = 1;
+          if (!full) {
+            for (double e : law.efficiency) factor = std::max(factor, e);
+          }
+          speed = factor * (w * v.amplitude + w * v.torsion_amplitude * r);
+          source = idx("fixtures", f) + ".law.vibration (peak velocity 2 pi f (A + theta r)" +
+                   (factor > 1 ? " times the largest efficiency factor)" : ")");
         } else if (law.has_calibrated_drift) {
           speed = twistSpeedOver(law.calibrated_drift, all);
           source = idx("fixtures", f) + ".law.calibrated_drift (over the fixture's extent)";

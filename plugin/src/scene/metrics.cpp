@@ -381,6 +381,15 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
     std::fprintf(stderr, "rheofeed: %s, %s: %s\n", scene.name.c_str(), toString(method),
                  healthSummary(m.health, m.parts).c_str());
   }
+  if (m.health.local_law_feeders > 0) {
+    const LocalDriftStats& l = m.health.local_law;
+    std::fprintf(stderr,
+                 "rheofeed: %s, %s: local vibration law on %d feeder(s): %lld contacts driven "
+                 "(%lld on walls or steep faces), %lld drift table cells, %lld point-mass runs\n",
+                 scene.name.c_str(), toString(method), m.health.local_law_feeders,
+                 static_cast<long long>(l.contacts), static_cast<long long>(l.wall_contacts),
+                 static_cast<long long>(l.cells_computed), static_cast<long long>(l.model_runs));
+  }
   return m;
 }
 
@@ -506,7 +515,15 @@ std::string summaryJson(const RunMetrics& r) {
   for (std::size_t k = 0; k < r.scene_check.size(); ++k) {
     json += (k ? ", " : "") + jsonQuoted(r.scene_check[k]);
   }
-  return json + "], \"feeder\": " + feederJson(r.feeder) + "}";
+  const LocalDriftStats& l = h.local_law;  // RunHealth::local_law (simulation.hpp)
+  char d[256];
+  std::snprintf(d, sizeof d,
+                "{\"feeders\": %d, \"contacts\": %lld, \"wall_contacts\": %lld, "
+                "\"cells_computed\": %lld, \"model_runs\": %lld}",
+                h.local_law_feeders, static_cast<long long>(l.contacts),
+                static_cast<long long>(l.wall_contacts), static_cast<long long>(l.cells_computed),
+                static_cast<long long>(l.model_runs));
+  return json + "], \"feeder\": " + feederJson(r.feeder) + ", \"local_law\": " + d + "}";
 }
 
 std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::string& folder,

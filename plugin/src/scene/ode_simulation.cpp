@@ -38,7 +38,8 @@ class OdeSimulation final : public PartSimulation {
     space_ = dHashSpaceCreate(nullptr);
     feeders_ = std::make_unique<FeederSet>();
 
-    for (const Fixture& f : scene.fixtures) {
+    for (std::size_t fi = 0; fi < scene.fixtures.size(); ++fi) {
+      const Fixture& f = scene.fixtures[fi];
       const bool vibrates = isFullVibration(method) && f.law.kind == FeederLaw::Kind::Vibration;
       dBodyID body = nullptr;
       if (vibrates) {
@@ -46,6 +47,8 @@ class OdeSimulation final : public PartSimulation {
         dBodySetKinematic(body);
         vibrating_.push_back({body, f.law.vibration});
       }
+      MotionLaw law;  // one law per fixture: its geoms share the local law's table
+      if (!body && f.law.kind != FeederLaw::Kind::None) law = feederLaw(static_cast<int>(fi));
       for (const Fixture::Geom& g : f.geoms) {
         dGeomID geom = createGeom(space_, g.shape, meshes_);
         if (g.shape.kind != Shape::Kind::Plane) setGeomPose(geom, g.pose);
@@ -57,7 +60,7 @@ class OdeSimulation final : public PartSimulation {
           toOdeMatrix(g.pose, r);
           dGeomSetOffsetWorldRotation(geom, r);
         } else if (f.law.kind != FeederLaw::Kind::None) {
-          feeders_->add(geom, rheonomicLaw(f));
+          feeders_->add(geom, law);
         }
         addFixtureGeom(geom);
       }
@@ -195,6 +198,8 @@ class OdeSimulation final : public PartSimulation {
     dBodySetRotation(b, r);
     dBodySetLinearVel(b, p.velocity.x, p.velocity.y, p.velocity.z);
     dGeomSetBody(createGeom(space_, p.shape, meshes_), b);
+    const double efficiency = partEfficiency(p.spec);
+    if (efficiency != 1.0) feeders_->setPartEfficiency(b, efficiency);
     parts_.push_back(b);
   }
 

@@ -31,12 +31,17 @@ class ReferenceSimulation final : public PartSimulation {
     s.surface_layer = scene.solver.surface_layer;
     world_ = std::make_unique<reference::World>(s);
 
-    for (const Fixture& f : scene.fixtures) {
+    for (std::size_t fi = 0; fi < scene.fixtures.size(); ++fi) {
+      const Fixture& f = scene.fixtures[fi];
       const bool vibrates = isFullVibration(method) && f.law.kind == FeederLaw::Kind::Vibration;
       BodyId body = reference::kStatic;
       if (vibrates) {
         const Vibration v = f.law.vibration;
         body = world_->addKinematicBody([v](double t) { return v.displacement(t); });
+      }
+      MotionLaw law;  // one law per fixture: its geoms share the local law's table
+      if (body == reference::kStatic && f.law.kind != FeederLaw::Kind::None) {
+        law = feederLaw(static_cast<int>(fi));
       }
       for (const Fixture::Geom& g : f.geoms) {
         dGeomID geom = createGeom(world_->space(), g.shape, meshes_);
@@ -44,7 +49,7 @@ class ReferenceSimulation final : public PartSimulation {
         if (body != reference::kStatic) {
           world_->attachGeom(geom, body, g.pose);  // the body's rest pose is the identity
         } else if (f.law.kind != FeederLaw::Kind::None) {
-          world_->setFeeder(geom, rheonomicLaw(f));
+          world_->setFeeder(geom, law);
         }
         addFixtureGeom(geom);
       }
@@ -123,6 +128,8 @@ class ReferenceSimulation final : public PartSimulation {
     state.orientation = reference::toQuat(p.pose);
     const BodyId body = world_->addBody(p.mass, p.inertia, state);
     world_->attachGeom(createGeom(world_->space(), p.shape, meshes_), body);
+    const double efficiency = partEfficiency(p.spec);
+    if (efficiency != 1.0) world_->setBodyEfficiency(body, efficiency);
     parts_.push_back(body);
   }
 

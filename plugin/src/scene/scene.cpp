@@ -138,7 +138,61 @@ void validateDistribution(const std::string& path, const Distribution& d, bool m
   }
 }
 
+// Whether a vibrating feeder's rheonomic law is the local law.
+bool usesLocalLaw(const FeederLaw& law) {
+  return law.kind == FeederLaw::Kind::Vibration && law.drift_model != DriftModel::CalibratedDrift;
+}
+
+// The factor of each part family on the local-law feeders (1 where none is given); throws
+// naming both fixtures when two of them disagree (FeederSet's factor is per body).
+std::vector<double> localEfficiencies(const std::vector<Fixture>& fixtures, std::size_t families,
+                                      const std::vector<PartSpec>& parts) {
+  std::vector<double> factor(families, 1.0);
+  std::vector<int> from(families, -1);  // the fixture that set factor[k]
+  for (std::size_t i = 0; i < fixtures.size(); ++i) {
+    const FeederLaw& law = fixtures[i].law;
+    if (!usesLocalLaw(law)) continue;
+    for (std::size_t k = 0; k < families; ++k) {
+      const double e = k < law.efficiency.size() ? law.efficiency[k] : 1.0;
+      if (from[k] >= 0 && e != factor[k]) {
+        std::ostringstream out;
+        out << "fixtures[" << i << "].law.efficiency[" << k << "] = " << e << ": part family '"
+            << parts[k].name << "' has factor " << factor[k] << " on fixtures[" << from[k]
+            << "] (a local feeder without factors counts as 1); a part's efficiency applies to "
+               "all its contacts with local-law feeders (FeederSet::setPartEfficiency is per "
+               "body), so the local feeders of a scene must agree on each family's factor";
+        throw std::invalid_argument(out.str());
+      }
+      factor[k] = e;
+      from[k] = static_cast<int>(i);
+    }
+  }
+  return factor;
+}
+
 }  // namespace
+
+const char* toString(DriftModel model) {
+  switch (model) {
+    case DriftModel::Local:
+      return "local";
+    case DriftModel::LocalSampled:
+      return "local_sampled";
+    case DriftModel::CalibratedDrift:
+      return "calibrated_drift";
+  }
+  return "?";
+}
+
+bool parseDriftModel(const std::string& name, DriftModel& model) {
+  for (DriftModel m : {DriftModel::Local, DriftModel::LocalSampled, DriftModel::CalibratedDrift}) {
+    if (name == toString(m)) {
+      model = m;
+      return true;
+    }
+  }
+  return false;
+}
 
 const char* toString(Shape::Kind kind) {
   switch (kind) {
@@ -325,8 +379,31 @@ void Scene::validate() const {
         }
         if (law.has_calibrated_drift)
           validateTwist(path + ".law.calibrated_drift", law.calibrated_drift);
+        if (!law.efficiency.empty()) {
+          const std::string ep = path + ".law.efficiency";
+          if (law.drift_model != DriftModel::LocalSampled) {
+            throw std::invalid_argument(ep +
+                                        ": efficiency factors apply to drift_model "
+                                        "local_sampled only; this feeder's drift_model is " +
+                                        toString(law.drift_model));
+          }
+          if (law.efficiency.size() != parts.size()) {
+            bad(ep + " size", static_cast<double>(law.efficiency.size()),
+                "must equal the number of part families (" + std::to_string(parts.size()) +
+                    "): one factor per family, in the order of parts");
+          }
+          for (std::size_t k = 0; k < law.efficiency.size(); ++k) {
+            within(ep + "[" + std::to_string(k) + "]", law.efficiency[k], 0, kMaxPartEfficiency, "",
+                   "a part family's own efficiency under the local law, 1 = a point mass");
+          }
+        }
         break;
       }
+    }
+    if (law.kind != FeederLaw::Kind::Vibration && !law.efficiency.empty()) {
+      throw std::invalid_argument(path +
+                                  ".law.efficiency: only a vibrating feeder has efficiency "
+                                  "factors");
     }
   }
   if (parts.empty()) throw std::invalid_argument("parts: a scene needs at least one part family");
@@ -368,6 +445,7 @@ void Scene::validate() const {
     nonNegative(path + ".rate", p.rate);
     magnitude(path + ".initial_velocity", p.initial_velocity, limits::kMaxSpeed, "m/s");
   }
+  (void)localEfficiencies(fixtures, parts.size(), parts);  // local feeders agree per family
 }
 
 bool Scene::hasMeshes() const {
@@ -389,8 +467,27 @@ bool Scene::hasVibration() const {
   return false;
 }
 
-MotionLaw rheonomicLaw(const Fixture& fixture) {
-  const FeederLaw& law = fixture.law;
+LocalVibration localVibration(const Vibration& vibration, const Vec3& gravity, double mu) {
+  LocalVibration v;
+  v.frequency = vibration.frequency;
+  v.amplitude = vibration.amplitude * vibration.direction;
+  v.torsion_amplitude = vibration.torsion_amplitude;
+  v.axis_origin = vibration.axis_origin;
+  v.axis_direction = vibration.axis_direction;
+  v.gravity = gravity;
+  v.efficiency = 1;
+  v.mu = mu;
+  return v;
+}
+
+MotionLaw rheonomicLaw(const Scene& scene, int fixture) {
+  if (fixture < 0 || fixture >= static_cast<int>(scene.fixtures.size())) {
+    throw std::invalid_argument("rheonomicLaw: fixture index " + std::to_string(fixture) +
+                                " is not in [0, " + std::to_string(scene.fixtures.size()) + ")");
+  }
+  const Fixture& f = scene.fixtures[static_cast<std::size_t>(fixture)];
+  const FeederLaw& law = f.law;
+  const std::string where = "fixtures[" + std::to_string(fixture) + "] ('" + f.name + "')";
   switch (law.kind) {
     case FeederLaw::Kind::None:
       return MotionLaw{};
@@ -399,14 +496,35 @@ MotionLaw rheonomicLaw(const Fixture& fixture) {
     case FeederLaw::Kind::Belt:
       return MotionLaw::belt(law.belt_direction, law.belt_speed);
     case FeederLaw::Kind::Vibration:
-      if (!law.has_calibrated_drift) {
-        throw std::invalid_argument("fixture '" + fixture.name +
-                                    "': a vibrating feeder needs a calibrated drift for a "
-                                    "rheonomic method (run the calibration first)");
+      switch (law.drift_model) {
+        case DriftModel::CalibratedDrift:
+          if (!law.has_calibrated_drift) {
+            throw std::invalid_argument(
+                where +
+                ": drift_model calibrated_drift needs a calibrated drift for a rheonomic method "
+                "(run the calibration first, or use drift_model local)");
+          }
+          return MotionLaw::twist(law.calibrated_drift);
+        case DriftModel::LocalSampled:
+          if (law.efficiency.empty()) {
+            throw std::invalid_argument(
+                where +
+                ": drift_model local_sampled needs the part families' efficiency factors for a "
+                "rheonomic method (run calibrateEfficiency first, or use drift_model local)");
+          }
+          [[fallthrough]];
+        case DriftModel::Local: {
+          const LocalVibration v = localVibration(law.vibration, scene.gravity, scene.material.mu);
+          v.validate(where + ".law.vibration");
+          return MotionLaw::localVibration(v);
+        }
       }
-      return MotionLaw::twist(law.calibrated_drift);
   }
   return MotionLaw{};
+}
+
+std::vector<double> partEfficiencies(const Scene& scene) {
+  return localEfficiencies(scene.fixtures, scene.parts.size(), scene.parts);
 }
 
 std::vector<PartInstance> drawParts(const Scene& scene) {

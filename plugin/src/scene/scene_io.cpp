@@ -296,7 +296,6 @@ void read(const json& v, const std::string& path, Vec3& out, UnitVector) {
 void read(const json& v, const std::string& path, Distribution& out);
 void read(const json& v, const std::string& path, Twist& out);
 void read(const json& v, const std::string& path, Pose& out);
-void read(const json& v, const std::string& path, FeederLaw& law);
 
 // A JSON object being read: every key asked for is remembered, and finish() refuses the rest.
 class Object {
@@ -457,7 +456,15 @@ void readScrew(Object& o, Vibration& v) {
   }
 }
 
-void read(const json& v, const std::string& path, FeederLaw& law) {
+// A law's "efficiency", read once the part families are known (readEfficiency).
+struct PendingEfficiency {
+  std::size_t fixture = 0;
+  const json* value = nullptr;
+  std::string path;
+};
+
+void readLaw(const json& v, const std::string& path, FeederLaw& law,
+             std::vector<PendingEfficiency>& pending, std::size_t fixture) {
   if (v.is_string() && v.get<std::string>() == "none") return;
   Object o(v, path);
   const char* kinds[] = {"drift", "belt", "vibration", "screw"};
@@ -473,8 +480,11 @@ void read(const json& v, const std::string& path, FeederLaw& law) {
          "for a fixture that does not move)");
   }
   const std::string kind = given;
-  if (o.has("calibrated_drift") && (kind == "drift" || kind == "belt")) {
-    fail(o.at("calibrated_drift"), "only a vibration or screw law has a calibrated drift");
+  for (const char* key : {"calibrated_drift", "drift_model", "efficiency"}) {
+    if (o.has(key) && (kind == "drift" || kind == "belt")) {
+      fail(o.at(key), std::string("only a vibration or screw law has a ") +
+                          (key == std::string("efficiency") ? "part efficiency" : key));
+    }
   }
   if (kind == "drift") {
     law.kind = FeederLaw::Kind::Drift;
@@ -491,8 +501,83 @@ void read(const json& v, const std::string& path, FeederLaw& law) {
     kind == "vibration" ? readVibration(body, law.vibration) : readScrew(body, law.vibration);
     body.finish();
     if (o.opt("calibrated_drift", law.calibrated_drift)) law.has_calibrated_drift = true;
+    // Without drift_model: a law that carries a calibrated drift keeps using it (files written
+    // before the local law behave as before); any other uses the local law.
+    law.drift_model = law.has_calibrated_drift ? DriftModel::CalibratedDrift : DriftModel::Local;
+    std::string model;
+    if (o.opt("drift_model", model) && !parseDriftModel(model, law.drift_model)) {
+      const std::vector<std::string> names = {"local", "local_sampled", "calibrated_drift"};
+      const std::string typo = closest(model, names);
+      fail(o.at("drift_model"), "unknown drift model \"" + model + "\"" +
+                                    (typo.empty() ? "" : " (did you mean \"" + typo + "\"?)") +
+                                    "; expected local, local_sampled or calibrated_drift");
+    }
+    if (const json* e = o.find("efficiency")) {
+      if (law.drift_model != DriftModel::LocalSampled) {
+        fail(o.at("efficiency"), std::string("efficiency factors apply to drift_model "
+                                             "local_sampled only; this law's drift_model is ") +
+                                     toString(law.drift_model) +
+                                     (o.has("drift_model") ? "" : " (the default)"));
+      }
+      pending.push_back({fixture, e, o.at("efficiency")});
+    }
   }
   o.finish();
+}
+
+// "efficiency": {"<part family name>": factor, ...} (families not named get 1) or an array of
+// one factor per family; each factor in [0, kMaxPartEfficiency].
+std::vector<double> readEfficiency(const json& v, const std::string& path,
+                                   const std::vector<PartSpec>& parts) {
+  std::vector<double> out(parts.size(), 1.0);
+  auto factor = [&](const json& x, const std::string& at, double& e) {
+    read(x, at, e, Range::NonNegative);
+    if (e > kMaxPartEfficiency) {
+      fail(at, "must be in [0, " + show(kMaxPartEfficiency) +
+                   "] (a part family's own efficiency under the local law, 1 = a point mass), "
+                   "got " +
+                   show(e));
+    }
+  };
+  if (v.is_array()) {
+    if (v.size() != parts.size()) {
+      fail(path, "an array of efficiency factors needs one per part family (" +
+                     std::to_string(parts.size()) + ", in the order of parts), got " + describe(v));
+    }
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      factor(v[k], path + "[" + std::to_string(k) + "]", out[k]);
+    }
+    return out;
+  }
+  if (!v.is_object()) {
+    fail(path, "expected {\"<part family name>\": factor, ...} or an array of factors, got " +
+                   describe(v));
+  }
+  std::vector<std::string> names;
+  for (const PartSpec& p : parts) names.push_back(p.name);
+  for (const auto& item : v.items()) {
+    const std::string at = path + "." + item.key();
+    std::size_t found = parts.size();
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      if (parts[k].name != item.key()) continue;
+      if (found != parts.size()) {
+        fail(at, "parts[" + std::to_string(found) + "] and parts[" + std::to_string(k) +
+                     "] are both named \"" + item.key() +
+                     "\"; give the efficiency as an array, one factor per family");
+      }
+      found = k;
+    }
+    if (found == parts.size()) {
+      std::string list;
+      for (const std::string& n : names) list += (list.empty() ? "\"" : ", \"") + n + "\"";
+      const std::string typo = closest(item.key(), names);
+      fail(at, "no part family is named \"" + item.key() + "\"" +
+                   (typo.empty() ? "" : " (did you mean \"" + typo + "\"?)") +
+                   "; the families are " + list);
+    }
+    factor(item.value(), at, out[found]);
+  }
+  return out;
 }
 
 Fixture::Geom readGeom(const json& v, const std::string& path) {
@@ -540,12 +625,13 @@ std::vector<T> readArray(const json& v, const std::string& path, F element) {
   return out;
 }
 
-Fixture readFixture(const json& v, const std::string& path) {
+Fixture readFixture(const json& v, const std::string& path, std::vector<PendingEfficiency>& pending,
+                    std::size_t index) {
   Object o(v, path);
   Fixture f;
   o.opt("name", f.name);
   f.geoms = readArray<Fixture::Geom>(o.require("geoms"), o.at("geoms"), readGeom);
-  o.opt("law", f.law);
+  if (const json* law = o.find("law")) readLaw(*law, o.at("law"), f.law, pending, index);
   o.finish();
   return f;
 }
@@ -596,9 +682,17 @@ Scene readScene(const json& root) {
   }
   o.opt("name", s.name);
   o.opt("gravity", s.gravity);
-  if (const json* v = o.find("fixtures"))
-    s.fixtures = readArray<Fixture>(*v, "fixtures", readFixture);
+  std::vector<PendingEfficiency> pending;
+  if (const json* v = o.find("fixtures")) {
+    std::size_t index = 0;
+    s.fixtures = readArray<Fixture>(*v, "fixtures", [&](const json& f, const std::string& path) {
+      return readFixture(f, path, pending, index++);
+    });
+  }
   s.parts = readArray<PartSpec>(o.require("parts"), "parts", readPart);
+  for (const PendingEfficiency& e : pending) {
+    s.fixtures[e.fixture].law.efficiency = readEfficiency(*e.value, e.path, s.parts);
+  }
   if (const json* v = o.find("material")) {
     Object m(*v, "material");
     m.opt("mu", s.material.mu, Range::NonNegative);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "rheofeed/scene/scene_io.hpp"
 
@@ -101,7 +102,21 @@ ojson toJson(const Fixture::Geom& g) {
   return out;
 }
 
-ojson toJson(const FeederLaw& law) {
+// A law's efficiency factors: an object keyed by part family name when the names are unique
+// and not empty (readable), else an array in the order of the parts.
+ojson efficiencyJson(const std::vector<double>& factors, const std::vector<PartSpec>& parts) {
+  bool named = factors.size() == parts.size();
+  for (std::size_t k = 0; k < parts.size() && named; ++k) {
+    if (parts[k].name.empty()) named = false;
+    for (std::size_t j = 0; j < k && named; ++j) named = parts[j].name != parts[k].name;
+  }
+  if (!named) return ojson(factors);
+  ojson out = ojson::object();
+  for (std::size_t k = 0; k < factors.size(); ++k) out[parts[k].name] = factors[k];
+  return out;
+}
+
+ojson toJson(const FeederLaw& law, const std::vector<PartSpec>& parts) {
   switch (law.kind) {
     case FeederLaw::Kind::None:
       return "none";
@@ -119,7 +134,9 @@ ojson toJson(const FeederLaw& law) {
                                     {"torsion_amplitude_rad", v.torsion_amplitude},
                                     {"axis_origin", toJson(v.axis_origin)},
                                     {"axis_direction", toJson(v.axis_direction)}}}};
+      out["drift_model"] = toString(law.drift_model);
       if (law.has_calibrated_drift) out["calibrated_drift"] = toJson(law.calibrated_drift);
+      if (!law.efficiency.empty()) out["efficiency"] = efficiencyJson(law.efficiency, parts);
       return out;
     }
   }
@@ -158,7 +175,7 @@ std::string toJson(const Scene& scene) {
     ojson geoms = ojson::array();
     for (const Fixture::Geom& g : f.geoms) geoms.push_back(toJson(g));
     fj["geoms"] = geoms;
-    if (f.law.kind != FeederLaw::Kind::None) fj["law"] = toJson(f.law);
+    if (f.law.kind != FeederLaw::Kind::None) fj["law"] = toJson(f.law, scene.parts);
     fixtures.push_back(fj);
   }
   out["fixtures"] = fixtures;

@@ -286,6 +286,21 @@ double partSpeed(const PartState& s, double radius) {
 PartSimulation::PartSimulation(const Scene& scene, Method method)
     : scene_(scene), method_(method), instances_(drawParts(scene)), limits_(sceneLimits(scene)) {
   health_.speed_bound = limits_.speed_bound;
+  if (!isFullVibration(method)) part_efficiency_ = partEfficiencies(scene);
+}
+
+MotionLaw PartSimulation::feederLaw(int fixture) {
+  MotionLaw law = rheonomicLaw(scene_, fixture);
+  if (law.kind() == MotionLaw::Kind::LocalVibration) {
+    local_laws_.push_back(law);
+    health_.local_law_feeders = static_cast<int>(local_laws_.size());
+  }
+  return law;
+}
+
+double PartSimulation::partEfficiency(int spec) const {
+  const std::size_t k = static_cast<std::size_t>(spec);
+  return k < part_efficiency_.size() ? part_efficiency_[k] : 1.0;
 }
 
 PartSimulation::~PartSimulation() {
@@ -497,6 +512,17 @@ void PartSimulation::step() {
   advance(h);
   time_ = ++steps_ * h;
   health_.steps = steps_;
+  if (!local_laws_.empty()) {
+    LocalDriftStats sum;
+    for (const MotionLaw& law : local_laws_) {
+      const LocalDriftStats s = law.localStats();
+      sum.contacts += s.contacts;
+      sum.wall_contacts += s.wall_contacts;
+      sum.cells_computed += s.cells_computed;
+      sum.model_runs += s.model_runs;
+    }
+    health_.local_law = sum;
+  }
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
     Track& tr = tracks_[i];
     if (!tr.active) continue;

@@ -53,6 +53,13 @@ class PartSimulation : public Simulation {
   void ignoreSetting(const std::string& message);
   /// Prints one line on stderr the first time `kind` (a short name) is seen in this run.
   void reportFirst(const std::string& kind, const std::string& line);
+  /// The law of fixture `fixture` in a rheonomic run (rheonomicLaw); a local law is
+  /// remembered, and its counts are summed into health_.local_law after every step.
+  MotionLaw feederLaw(int fixture);
+  /// The efficiency factor of part family `spec` on the local-law feeders (partEfficiencies;
+  /// 1 in full-vibration runs and without local_sampled feeders). Engines set it on a part
+  /// that is not 1 (FeederSet::setPartEfficiency, World::setBodyEfficiency).
+  double partEfficiency(int spec) const;
   /// The engine found part `index` non-finite and took it out itself (the reference world
   /// disables such a body at its last finite pose): the next check counts it as non-finite.
   void markNonFinite(int index);
@@ -94,6 +101,8 @@ class PartSimulation : public Simulation {
 
   const Method method_;
   const std::vector<PartInstance> instances_;
+  std::vector<MotionLaw> local_laws_;    // rheonomic local laws (copies share their tables)
+  std::vector<double> part_efficiency_;  // per part family; empty in full-vibration runs
   const SceneLimits limits_;
   std::size_t next_ = 0;
   std::vector<Track> tracks_;

@@ -171,7 +171,9 @@ double studentT95(int dof);
 std::string seriesCsv(const RunMetrics& run);
 /// One-line JSON summary of a run: all scalar fields, a "health" object with every count of
 /// RunHealth, parts_lost, the share of Coulomb fallback steps, the maximum part speed and its
-/// bound, and the list of ignored settings, and a "feeder" object (feederJson, output.hpp).
+/// bound, and the list of ignored settings; the scene check's warnings; a "feeder" object
+/// (feederJson, output.hpp); and a "local_law" object (RunHealth::local_law: feeders, contacts,
+/// wall_contacts, cells_computed, model_runs).
 std::string summaryJson(const RunMetrics& run);
 /// One line naming what a run lost, could not trust or ignored, e.g. "3 of 60 parts lost
 /// (fell 2, through a fixture 1); ..."; "nothing lost" when RunHealth::anything() is false.

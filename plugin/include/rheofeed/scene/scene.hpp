@@ -78,15 +78,39 @@ struct Vibration {
   bool isZero() const { return amplitude == 0 && torsion_amplitude == 0; }
 };
 
+/// How a rheonomic run replaces a feeder's vibration (FeederLaw::Kind::Vibration; issue 8).
+enum class DriftModel {
+  /// The local vibration law (MotionLaw::localVibration, vibration_drift.hpp): at each contact
+  /// the point-mass drift of the feeder's real vibration at that point, for that contact's
+  /// normal, the scene's gravity and the material's mu. No sampling run. The default.
+  Local,
+  /// The local law times the part family's own efficiency (FeederLaw::efficiency), measured by
+  /// a short sampling run (calibration.hpp, calibrateEfficiency).
+  LocalSampled,
+  /// One constant drift twist per feeder (FeederLaw::calibrated_drift), from a sampling run or
+  /// the classical model: exact only where it was calibrated (issue 8).
+  CalibratedDrift,
+};
+/// Printable name, as in scene files: "local", "local_sampled", "calibrated_drift".
+const char* toString(DriftModel model);
+/// The model named `name` (as toString writes it); false if there is none.
+bool parseDriftModel(const std::string& name, DriftModel& model);
+
+/// Largest part efficiency factor (dimensionless), as FeederSet::setPartEfficiency accepts.
+constexpr double kMaxPartEfficiency = 100;
+
 /// How a feeder moves.
 struct FeederLaw {
   enum class Kind {
     None,       ///< not a feeder: plain static geometry
     Drift,      ///< a drift field: rheonomic twist, the homogenised transport velocity itself
     Belt,       ///< a belt of speed `belt_speed` along `belt_direction`
-    Vibration,  ///< a real vibration; rheonomic methods use its calibrated drift field
+    Vibration,  ///< a real vibration; rheonomic methods use its drift model (drift_model)
   };
   Kind kind = Kind::None;
+  /// Vibration: what rheonomic runs use instead of it (default: the local law). Ignored by
+  /// other kinds and by full-vibration runs.
+  DriftModel drift_model = DriftModel::Local;
   /// Drift: v (m/s, |v| <= 1e3), w (rad/s, |w| <= 1e4) about origin (m, in [-1e6, 1e6]),
   /// world frame.
   Twist drift;
@@ -97,6 +121,15 @@ struct FeederLaw {
   /// the calibration step or given by the scene ("vibration, calibrated"); limits as drift.
   bool has_calibrated_drift = false;
   Twist calibrated_drift;
+  /// Vibration with DriftModel::LocalSampled: the part families' own efficiency under the
+  /// local law, indexed like Scene::parts (dimensionless, each in [0, kMaxPartEfficiency]; 1 =
+  /// a point mass). Empty: not measured yet (a rheonomic run then refuses the scene; the demos
+  /// calibrate first). Must be empty for the other drift models. A rheonomic run applies the
+  /// factor of family k to every contact of its parts with every local-law feeder
+  /// (FeederSet::setPartEfficiency is per body), so all local-law feeders of a scene must
+  /// agree on each family's factor (a `local` feeder counts as 1); Scene::validate refuses
+  /// feeders that disagree.
+  std::vector<double> efficiency;
 };
 
 /// A fixture: static geometry, optionally a feeder. All its geoms move together in a full
@@ -235,9 +268,25 @@ struct Scene {
   bool hasVibration() const;
 };
 
-/// The motion law a rheonomic method uses for a fixture (None -> not a feeder). Throws if a
-/// vibrating fixture has no calibrated drift.
-MotionLaw rheonomicLaw(const Fixture& fixture);
+/// The local vibration of `vibration` for the local law (vibration_drift.hpp): translation
+/// amplitude vector amplitude * direction (m), torsion_amplitude (rad) about the axis, the
+/// scene's `gravity` (m/s^2, world) and the material's `mu` (used where a caller passes no
+/// contact mu), efficiency 1 (part families get theirs per body: partEfficiencies).
+LocalVibration localVibration(const Vibration& vibration, const Vec3& gravity, double mu);
+
+/// The motion law a rheonomic method uses for fixture `fixture` of `scene` (None: a stationary
+/// surface). A vibrating fixture gives, by its drift model, the local law
+/// (MotionLaw::localVibration of localVibration(vibration, scene.gravity, scene.material.mu))
+/// or its calibrated drift twist. Throws std::invalid_argument naming the fixture when the
+/// index is out of range, a calibrated_drift model has no calibrated drift, or a local_sampled
+/// model has no efficiency factors ("run the calibration first").
+MotionLaw rheonomicLaw(const Scene& scene, int fixture);
+
+/// The efficiency factor (dimensionless) of each part family (indexed like Scene::parts) on
+/// the scene's local-law feeders: the local_sampled feeders' factors, 1 where none is given.
+/// Throws std::invalid_argument naming both fixtures when two local-law feeders disagree on a
+/// family's factor (as Scene::validate does).
+std::vector<double> partEfficiencies(const Scene& scene);
 
 /// One part instance, drawn from a PartSpec (deterministic from the scene seed).
 struct PartInstance {

@@ -89,6 +89,13 @@ struct RunHealth {
   /// SceneLimits::speed_bound).
   double max_part_speed = 0;
   double speed_bound = 0;
+  /// Rheonomic runs: feeders driven by the local vibration law (DriftModel local or
+  /// local_sampled; 0 when none), and that law's counts summed over them since the start
+  /// (MotionLaw::localStats): contacts driven, of which walls (the horizontal surface's drift
+  /// used: walls, overhangs, slopes beyond the friction angle), drift table cells filled and
+  /// point-mass model runs. Informative, not a loss: not part of anything().
+  int local_law_feeders = 0;
+  LocalDriftStats local_law;
   /// Parts lost in any way but the exit: fell + through_fixture + out_of_bounds + nonfinite +
   /// too_fast, plus those inside a fixture now.
   int partsLost() const {
