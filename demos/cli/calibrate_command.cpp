@@ -72,11 +72,18 @@ int calibrateCommand(const CalibrateArgs& args) {
   try {
     Scene scene = plan.scene;
     CalibrateOptions options = args.calibrate;
+    options.rheonomic_time_step = sceneStep(scene, Method::OdeRheonomic, nullptr);
     const CalibrateReport report = calibrateScene(scene, options, "rheofeed calibrate", stderr);
+    if (report.calibrated == 0 && report.given == 0) {
+      throw std::invalid_argument(
+          "scene " + plan.file.string() +
+          ": every vibrating feeder uses the local vibration law, which needs no calibration "
+          "(nothing written); --drift-model local_sampled or calibrated_drift calibrates one");
+    }
     if (report.calibrated == 0) {
       std::fprintf(stderr,
-                   "rheofeed calibrate: the scene gives the calibrated drift of every vibrating "
-                   "fixture; writing it unchanged (--force calibrates again)\n");
+                   "rheofeed calibrate: the scene gives the calibration of every vibrating "
+                   "fixture that takes one; writing it unchanged (--force calibrates again)\n");
     }
     const std::filesystem::path folder = out.parent_path().empty() ? "." : out.parent_path();
     for (Fixture& f : scene.fixtures) {

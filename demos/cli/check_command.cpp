@@ -37,13 +37,16 @@ int checkCommand(const SceneArgs& args) {
     hazards += static_cast<int>(found.size());
   }
   for (const Fixture& f : plan.scene.fixtures) {
-    if (f.law.kind == FeederLaw::Kind::Vibration && !f.law.has_calibrated_drift) {
-      std::printf(
-          "note: fixture '%s' vibrates and the scene gives no calibrated drift: a "
-          "rheonomic `rheofeed run` calibrates it first at every launch; `rheofeed "
-          "calibrate %s --out NEW.json` saves it\n",
-          f.name.c_str(), args.scene.c_str());
-    }
+    if (f.law.kind != FeederLaw::Kind::Vibration) continue;
+    Scene one;
+    one.fixtures = {f};
+    const std::string missing =
+        needsCalibration(one) ? ", which the scene does not give: `rheofeed run` calibrates it at "
+                                "every launch, `rheofeed calibrate " +
+                                    args.scene + " --out NEW.json` saves it"
+                              : std::string();
+    std::printf("note: fixture '%s' vibrates; rheonomic runs use drift model %s%s\n",
+                f.name.c_str(), toString(f.law.drift_model), missing.c_str());
   }
   std::printf("%s\n",
               hazards == 0 ? "no hazards" : (std::to_string(hazards) + " hazard(s)").c_str());

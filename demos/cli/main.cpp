@@ -26,11 +26,21 @@ std::string shippedList() {
 }
 
 // The options every subcommand that loads a scene takes.
-void addSceneArgs(CLI::App* sub, SceneArgs& a, bool with_methods, bool with_overrides) {
+void addSceneArgs(CLI::App* sub, SceneArgs& a, bool with_methods, bool with_overrides,
+                  bool with_drift_model) {
   sub->add_option("SCENE", a.scene,
                   "a shipped scene (" + shippedList() +
                       ") or a scene file (a path with a '/' or ending in .json)")
       ->required();
+  if (with_drift_model) {
+    sub->add_option("--drift-model", a.drift_model,
+                    "what the rheonomic runs use instead of a feeder's vibration, for every "
+                    "vibrating feeder: local (the local vibration law, no calibration), "
+                    "local_sampled (the local law times each part family's efficiency, measured "
+                    "by a short sampling run unless the scene gives it), calibrated_drift (one "
+                    "constant drift twist, calibrated unless the scene gives it)")
+        ->default_str("each feeder's drift_model in the scene");
+  }
   if (with_methods) {
     sub->add_option("--method", a.methods, "methods, repeated or comma-separated: " + methodNames())
         ->delimiter(',');
@@ -74,7 +84,7 @@ int main(int argc, char** argv) {
 
   RunArgs run;
   CLI::App* run_cmd = app.add_subcommand("run", "run a scene and write its outputs");
-  addSceneArgs(run_cmd, run.scene, true, true);
+  addSceneArgs(run_cmd, run.scene, true, true, true);
   run_cmd->get_option("--method")->default_str("ode_rheonomic");
   run_cmd->add_option("--out", run.out, "output folder")->default_str("out/<scene name>");
   bool no_animation = false;
@@ -91,7 +101,7 @@ int main(int argc, char** argv) {
       "calibrate",
       "calibrate the drift of the scene's vibrating feeders and write the scene with it, so "
       "that later runs start at once");
-  addSceneArgs(cal_cmd, cal.scene, false, false);
+  addSceneArgs(cal_cmd, cal.scene, false, false, true);
   cal_cmd->add_option("--out", cal.out, "the new scene file (.json)")->required();
   addCalibrateOptions(cal_cmd, cal.calibrate);
   cal_cmd
@@ -104,14 +114,14 @@ int main(int argc, char** argv) {
       "check",
       "validate a scene and print the hazards of the scene check for each method at the step it "
       "takes (exit code 0: none, 1: hazards, 2: invalid)");
-  addSceneArgs(check_cmd, check, true, true);
+  addSceneArgs(check_cmd, check, true, true, true);
   check_cmd->get_option("--method")
       ->default_str("ode_rheonomic, and ode_full_vibration when a feeder vibrates");
 
   StudyArgs study;
   CLI::App* study_cmd = app.add_subcommand(
       "study", "the error-vs-cost study: rheonomic vs full vibration over a sweep of steps");
-  addSceneArgs(study_cmd, study.scene, false, false);
+  addSceneArgs(study_cmd, study.scene, false, false, false);
   study_cmd->add_option("--out", study.out, "output folder")->default_str("out/<scene name>_study");
   study_cmd->add_option("--seeds", study.seeds, "seeds of the converged reference")
       ->check(CLI::Range(1, 50))

@@ -93,11 +93,27 @@ int runCommand(const RunArgs& args) {
       any_rheonomic = any_rheonomic || !isFullVibration(r.method);
     Scene calibrated = plan.scene;
     if (any_rheonomic && needsCalibration(calibrated)) {
-      const CalibrateReport c = calibrateScene(calibrated, args.calibrate, "rheofeed run", stderr);
+      CalibrateOptions options = args.calibrate;
+      for (const PlannedRun& r : plan.runs) {  // local_sampled: measured at the rheonomic step
+        if (!isFullVibration(r.method)) options.rheonomic_time_step = r.scene.solver.time_step;
+      }
+      const CalibrateReport c = calibrateScene(calibrated, options, "rheofeed run", stderr);
       std::fprintf(stderr,
                    "rheofeed run: calibration took %.1f s CPU; `rheofeed calibrate %s --out "
                    "NEW.json` saves it so that runs of NEW.json start at once\n",
-                   c.cpu_seconds, args.scene.scene.c_str());
+                   c.cpu_seconds,
+                   (args.scene.scene + (args.scene.drift_model.empty()
+                                            ? std::string()
+                                            : " --drift-model " + args.scene.drift_model))
+                       .c_str());
+    } else if (any_rheonomic) {
+      for (const Fixture& f : calibrated.fixtures) {
+        if (f.law.kind != FeederLaw::Kind::Vibration) continue;
+        std::fprintf(stderr, "rheofeed run: fixture '%s': drift model %s%s\n", f.name.c_str(),
+                     toString(f.law.drift_model),
+                     f.law.drift_model == DriftModel::Local ? " (the local vibration law)"
+                                                            : " (from the scene)");
+      }
     }
 
     const std::string unit = plan.scene.outputs.angular_drift ? "rad/s" : "m/s";

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "cli/calibrate_scene.hpp"
 #include "cli/shipped_scenes.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 
@@ -68,6 +69,10 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
     requirePositiveFinite("--dt", args.dt);
   }
   if (args.duration_given) requirePositiveFinite("--duration", args.duration);
+  if (!args.drift_model.empty()) {
+    Scene probe;  // the name is checked before the scene is read
+    overrideDriftModel(probe, args.drift_model);
+  }
 
   Plan plan;
   plan.file = resolveScene(args.scene);
@@ -76,6 +81,7 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
   Scene& scene = plan.scene;
   if (args.duration_given) scene.duration = args.duration;
   if (args.seed_given) scene.seed = args.seed;
+  if (!args.drift_model.empty()) overrideDriftModel(scene, args.drift_model);
   const std::string where =
       "scene " + plan.file.string() +
       (args.duration_given ? " with --duration " + number(args.duration) + " s" : std::string());

@@ -30,6 +30,9 @@ struct SceneArgs {
   bool duration_given = false;
   std::uint64_t seed = 0;  ///< --seed, when seed_given
   bool seed_given = false;
+  /// --drift-model: empty keeps each vibrating feeder's drift model; else local, local_sampled
+  /// or calibrated_drift for all of them (overrideDriftModel, calibrate_scene.hpp).
+  std::string drift_model;
 };
 
 /// One run: its method, its scene (the overrides and its time step applied, validated) and where
