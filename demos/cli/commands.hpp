@@ -17,7 +17,8 @@ namespace rheofeed::cli {
 /// table on stdout; its last line names view.html when it was written.
 struct RunArgs {
   SceneArgs scene;
-  std::string out;  ///< output folder; empty: out/<scene name>
+  std::string out;  ///< output folder (out_given); else out/<scene name>
+  bool out_given = false;
   bool animation = true;
   CalibrateOptions calibrate;
 };
@@ -42,7 +43,8 @@ int calibrateCommand(const CalibrateArgs& args);
 /// `rheofeed study SCENE`: the error-vs-cost study (demos/common/study.hpp) of the scene.
 struct StudyArgs {
   SceneArgs scene;
-  std::string out;  ///< empty: out/<scene name>_study
+  std::string out;  ///< output folder (out_given); else out/<scene name>_study
+  bool out_given = false;
   int seeds = 3;
   bool quick = false;
 };

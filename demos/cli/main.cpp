@@ -86,7 +86,9 @@ int main(int argc, char** argv) {
   CLI::App* run_cmd = app.add_subcommand("run", "run a scene and write its outputs");
   addSceneArgs(run_cmd, run.scene, true, true, true);
   run_cmd->get_option("--method")->default_str("ode_rheonomic");
-  run_cmd->add_option("--out", run.out, "output folder")->default_str("out/<scene name>");
+  run_cmd->add_option("--out", run.out, "output folder")
+      ->default_str("out/<scene name>")
+      ->each([&run](const std::string&) { run.out_given = true; });
   bool no_animation = false;
   run_cmd
       ->add_flag("--no-animation", no_animation,
@@ -122,7 +124,9 @@ int main(int argc, char** argv) {
   CLI::App* study_cmd = app.add_subcommand(
       "study", "the error-vs-cost study: rheonomic vs full vibration over a sweep of steps");
   addSceneArgs(study_cmd, study.scene, false, false, false);
-  study_cmd->add_option("--out", study.out, "output folder")->default_str("out/<scene name>_study");
+  study_cmd->add_option("--out", study.out, "output folder")
+      ->default_str("out/<scene name>_study")
+      ->each([&study](const std::string&) { study.out_given = true; });
   study_cmd->add_option("--seeds", study.seeds, "seeds of the converged reference")
       ->check(CLI::Range(1, 50))
       ->capture_default_str();

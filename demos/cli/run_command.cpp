@@ -77,8 +77,8 @@ int runCommand(const RunArgs& args) {
   std::filesystem::path out;
   try {
     plan = makePlan(args.scene, {"ode_rheonomic"});
-    out = args.out.empty() ? std::filesystem::path("out") / plan.name
-                           : std::filesystem::path(args.out);
+    out = !args.out_given ? std::filesystem::path("out") / plan.name
+                          : std::filesystem::path(args.out);
     prepareOutputFolder(out, "--out");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rheofeed run: %s\n", e.what());

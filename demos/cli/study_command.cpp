@@ -19,7 +19,7 @@ int studyCommand(const StudyArgs& args) {
                                   ": no vibrating feeder; the study compares a vibrating feeder "
                                   "with its rheonomic replacement");
     }
-    options.out_dir = args.out.empty() ? "out/" + plan.name + "_study" : args.out;
+    options.out_dir = !args.out_given ? "out/" + plan.name + "_study" : args.out;
     options.seeds = args.seeds;
     options.quick = args.quick;
     prepareOutputFolder(options.out_dir, "--out");
