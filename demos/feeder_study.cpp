@@ -2,80 +2,41 @@
 // The error-vs-run-time study: does a stationary feeder with rheonomic contacts reproduce the
 // transport of a really vibrating feeder, and at what cost?
 //
-// For a scene with a vibrating feeder it
-//  1. runs the converged reference: ODE full vibration at the finest step, over several seeds;
-//  2. calibrates the vibration into a drift field (a short full-vibration run of a sample);
-//  3. sweeps the time step of each method (ODE and reference solver, full vibration and
-//     rheonomic), measuring CPU time and the error of the mean drift against the reference;
-//  4. writes study.csv, study.md (table + speed-up at equal error) and study.png (log-log error
-//     vs CPU time, one curve per method) into --out.
+// The study itself is demos/common/study.cpp (also `rheofeed study SCENE`); this binary adds the
+// built-in scenes of the study (track, trough, heap, hopper) that have no scene file.
 //
 //   feeder_study [--scene track|trough|heap|hopper|FILE.json] [--out out/study] [--seeds 3]
 //   [--quick]
 //                [--rtf-parts 500]
-//
-// With --drift-models it instead compares the four drift models of a rheonomic run (the local
-// vibration law, the local law with a sampled efficiency, the sampled constant, the classical
-// constant) against full vibration on the study's scenes (study/drift_models.hpp):
-//
-//   feeder_study --drift-models [--out demos/results] [--only track_level,hopper,...]
-//                [--ref-steps-per-cycle 1000] [--quick]
 #include <CLI/CLI.hpp>
-#include <algorithm>
-#include <cmath>
 #include <cstdio>
-#include <map>
-#include <sstream>
+#include <exception>
 #include <string>
-#include <vector>
 
+#include "common/study.hpp"
 #include "rheofeed/scene/builtin_scenes.hpp"
-#include "rheofeed/scene/calibration.hpp"
-#include "rheofeed/scene/metrics.hpp"
-#include "rheofeed/scene/output.hpp"
-#include "rheofeed/scene/plot.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 #include "study/drift_models.hpp"
 
-namespace {
-
-using namespace rheofeed;
-using namespace rheofeed::scene;
-
-constexpr double kTargetError = 0.05;  // "equal drift error": 5 % of the reference drift
-
-struct Row {
-  Method method;
-  double time_step;
-  double steps_per_cycle;  // 0 for rheonomic
-  RunMetrics metrics;
-  double error = 0;  // |drift - reference| / |reference|
-};
-
-int vibratingFixture(const Scene& s) {
-  for (std::size_t i = 0; i < s.fixtures.size(); ++i) {
-    if (s.fixtures[i].law.kind == FeederLaw::Kind::Vibration) return static_cast<int>(i);
-  }
-  throw std::invalid_argument("scene '" + s.name + "' has no vibrating feeder to study");
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
-  std::string scene_arg = "track", out_dir = "out/study";
-  int seeds = 3;
-  bool quick = false;
-  int rtf_parts = 0;
+  using namespace rheofeed::scene;
+  std::string scene_arg = "track";
+  rheofeed::demo::StudyOptions options;
   CLI::App app{"rheofeed error-vs-run-time study: rheonomic vs full vibration"};
   app.add_option("--scene", scene_arg,
                  "built-in scene (track: one part; trough: 40 parts in a layer; heap: 40 "
-                 "parts in a heap; hopper: the linear_feeder demo) or a scene file (.json)");
-  app.add_option("--out", out_dir, "output folder");
-  app.add_option("--seeds", seeds, "seeds of the converged reference")->check(CLI::Range(1, 50));
-  app.add_flag("--quick", quick, "coarser sweeps and a shorter reference (for a smoke run)");
-  app.add_option("--rtf-parts", rtf_parts,
+                 "parts in a heap; hopper: the linear_trough scene) or a scene file (.json)")
+      ->capture_default_str();
+  app.add_option("--out", options.out_dir, "output folder")->capture_default_str();
+  app.add_option("--seeds", options.seeds, "seeds of the converged reference")
+      ->check(CLI::Range(1, 50))
+      ->capture_default_str();
+  app.add_flag("--quick", options.quick,
+               "coarser sweeps and a shorter reference (for a smoke run)");
+  app.add_option("--rtf-parts", options.rtf_parts,
                  "also measure the real-time factor of the rheonomic ODE run with this many "
-                 "parts (trough scene)");
+                 "parts (trough scene)")
+      ->capture_default_str();
   bool drift_models = false;
   rheofeed::demo::DriftModelStudyOptions dm;
   app.add_flag("--drift-models", drift_models,
@@ -93,175 +54,18 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (drift_models) {
-    dm.out_dir = out_dir;
-    dm.quick = quick;
+    dm.out_dir = options.out_dir;
+    dm.quick = options.quick;
     return rheofeed::demo::runDriftModelStudy(dm);
   }
-
   try {
-    Scene scene = scene_arg == "track"    ? vibratingTrackScene()
-                  : scene_arg == "trough" ? troughScene()
-                  : scene_arg == "heap"   ? troughScene(40, true)
-                  : scene_arg == "hopper" ? linearTroughScene()
-                                          : loadScene(scene_arg);
-    scene.validate();
-    const int fixture = vibratingFixture(scene);
-    const Vibration& vib = scene.fixtures[static_cast<std::size_t>(fixture)].law.vibration;
-    const double f = vib.frequency;
-    std::fprintf(stderr, "feeder_study: scene '%s', %.1f Hz, amplitude %.3g m\n",
-                 scene.name.c_str(), f, vib.amplitude);
-
-    // 1. Converged reference: ODE full vibration at the finest step, several seeds.
-    const int ref_steps_per_cycle = quick ? 400 : 1000;
-    std::vector<double> ref_drifts;
-    double ref_cpu = 0;
-    for (int k = 0; k < seeds; ++k) {
-      Scene s = scene;
-      s.seed = scene.seed + k;
-      s.solver.time_step = 1.0 / (f * ref_steps_per_cycle);
-      const RunMetrics m = measureRun(
-          s, Method::OdeFullVibration,
-          stderrProgress("reference seed " + std::to_string(k + 1) + "/" + std::to_string(seeds)));
-      ref_drifts.push_back(m.mean_drift);
-      ref_cpu += m.cpu_seconds;
-    }
-    double ref = 0;
-    for (double d : ref_drifts) ref += d;
-    ref /= seeds;
-    double ss = 0;
-    for (double d : ref_drifts) ss += (d - ref) * (d - ref);
-    const double ref_ci =
-        seeds > 1 ? studentT95(seeds - 1) * std::sqrt(ss / (seeds - 1)) / std::sqrt(double(seeds))
-                  : 0;
-    if (std::abs(ref) < 1e-9)
-      throw std::runtime_error("the reference drift is zero: nothing to study");
-    std::fprintf(stderr, "reference drift %.6g +- %.2g m/s (%d seeds, %d steps/cycle)\n", ref,
-                 ref_ci, seeds, ref_steps_per_cycle);
-
-    // 2. Calibration of the vibration into a drift field.
-    CalibrationSettings cs;
-    if (quick) cs.measure_cycles = 40;
-    const Calibration cal = calibrateBySampling(scene, fixture, cs);
-    std::fprintf(stderr, "calibrated drift %.6g +- %.2g m/s (efficiency %.3f, %.2f s CPU)\n",
-                 cal.value, cal.ci95, cal.efficiency, cal.cpu_seconds);
-    const Scene calibrated = withCalibration(scene, cal);
-    std::string classical_line;
-    try {
-      const Calibration estimate = calibrateClassical(scene, fixture);
-      std::ostringstream q;
-      q << "Classical single-part estimate: " << estimate.value << " m/s ("
-        << 100 * std::abs(estimate.value - ref) / std::abs(ref) << " % from the reference).\n";
-      classical_line = q.str();
-    } catch (const std::exception& e) {
-      classical_line =
-          std::string("Classical single-part estimate: not applicable (") + e.what() + ").\n";
-    }
-
-    // 3. Sweeps.
-    std::vector<Row> rows;
-    const std::vector<double> spc =
-        quick ? std::vector<double>{25, 100} : std::vector<double>{20, 50, 100, 200, 400};
-    const std::vector<double> steps = quick ? std::vector<double>{0.02, 0.005}
-                                            : std::vector<double>{0.04, 0.02, 0.01, 0.005, 0.0025};
-    for (Method m : {Method::OdeFullVibration, Method::ReferenceFullVibration}) {
-      for (double n : spc) {
-        Scene s = scene;
-        s.solver.time_step = 1.0 / (f * n);
-        char label[96];
-        std::snprintf(label, sizeof label, "%s %g steps/cycle", toString(m), n);
-        rows.push_back({m, s.solver.time_step, n, measureRun(s, m, stderrProgress(label))});
-      }
-    }
-    for (Method m : {Method::OdeRheonomic, Method::ReferenceRheonomic}) {
-      for (double h : steps) {
-        Scene s = calibrated;
-        s.solver.time_step = h;
-        s.outputs.sample_interval = std::max(h, scene.outputs.sample_interval);
-        char label[96];
-        std::snprintf(label, sizeof label, "%s h = %g s", toString(m), h);
-        rows.push_back({m, h, 0, measureRun(s, m, stderrProgress(label))});
-      }
-    }
-    for (Row& r : rows) r.error = std::abs(r.metrics.mean_drift - ref) / std::abs(ref);
-
-    // 4. Outputs.
-    std::ostringstream csv, md;
-    csv << "method,time_step_s,steps_per_cycle,mean_drift_mps,ci95_mps,error,cpu_s,"
-           "real_time_factor,parts\n";
-    md << "Scene `" << scene.name << "`: reference drift " << ref << " m/s (+- " << ref_ci
-       << ", ODE full vibration, " << ref_steps_per_cycle << " steps/cycle, " << seeds
-       << " seeds); calibrated drift " << cal.value << " +- " << cal.ci95 << " m/s (" << cal.how
-       << ", " << cal.cpu_seconds << " s CPU once).\n\n"
-       << classical_line << "\n"
-       << "| method | h (s) | steps/cycle | drift (m/s) | error | CPU (s) | real-time factor |\n"
-       << "|---|---|---|---|---|---|---|\n";
-    char line[256];
-    for (const Row& r : rows) {
-      std::snprintf(line, sizeof line, "%s,%.6g,%.6g,%.8g,%.6g,%.6g,%.6g,%.6g,%d\n",
-                    toString(r.method), r.time_step, r.steps_per_cycle, r.metrics.mean_drift,
-                    r.metrics.mean_drift_ci95, r.error, r.metrics.cpu_seconds,
-                    r.metrics.real_time_factor, r.metrics.parts);
-      csv << line;
-      std::snprintf(line, sizeof line, "| %s | %.3g | %s | %.5f | %.1f %% | %.3f | %.4f |\n",
-                    toString(r.method), r.time_step,
-                    r.steps_per_cycle > 0 ? std::to_string(int(r.steps_per_cycle)).c_str() : "-",
-                    r.metrics.mean_drift, 100 * r.error, r.metrics.cpu_seconds,
-                    r.metrics.real_time_factor);
-      md << line;
-    }
-    // Speed-up at equal error: cheapest run within the target error, per method.
-    std::map<Method, double> cheapest;
-    for (const Row& r : rows) {
-      if (r.error > kTargetError) continue;
-      auto it = cheapest.find(r.method);
-      if (it == cheapest.end() || r.metrics.cpu_seconds < it->second) {
-        cheapest[r.method] = r.metrics.cpu_seconds;
-      }
-    }
-    md << "\nCheapest run within " << 100 * kTargetError << " % drift error:\n\n"
-       << "| method | CPU (s) |\n|---|---|\n";
-    for (const auto& [m, cpu] : cheapest) md << "| " << toString(m) << " | " << cpu << " |\n";
-    auto speedup = [&](Method full, Method rheo) {
-      if (!cheapest.count(full) || !cheapest.count(rheo))
-        return std::string("n/a (a method never reached the target error)");
-      std::ostringstream s;
-      s << cheapest[full] / cheapest[rheo] << "x ("
-        << cheapest[full] / (cheapest[rheo] + cal.cpu_seconds)
-        << "x counting the calibration once)";
-      return s.str();
-    };
-    md << "\nSpeed-up at equal error (<= " << 100 * kTargetError << " %): ODE "
-       << speedup(Method::OdeFullVibration, Method::OdeRheonomic) << "; reference solver "
-       << speedup(Method::ReferenceFullVibration, Method::ReferenceRheonomic) << ".\n";
-
-    if (rtf_parts > 0) {
-      Scene big = withCalibration(linearTroughScene(rtf_parts, 100), cal);
-      big.solver.time_step = 0.01;
-      big.duration = std::max(6.0, rtf_parts / 100.0 + 2.0);
-      const RunMetrics m = measureRun(big, Method::OdeRheonomic, stderrProgress("rtf run"));
-      md << "\nReal-time factor, ODE + plugin, linear trough with " << m.parts
-         << " parts, h = 0.01 s: " << m.real_time_factor << " (CPU " << m.cpu_seconds << " s for "
-         << m.simulated_seconds << " s).\n";
-    }
-
-    const std::filesystem::path out(out_dir);
-    writeFileAtomically(out / "study.csv", csv.str());
-    writeFileAtomically(out / "study.md", md.str());
-    std::ostringstream gp;
-    gp << "set datafile separator ','\nset logscale xy\nset grid\nset key outside right\n"
-       << "set xlabel 'CPU time (s)'\nset ylabel 'relative drift error'\n"
-       << "set title '" << scene.name << ": drift error vs CPU time'\n"
-       << "plot ";
-    const char* methods[] = {"ode_full_vibration", "reference_full_vibration", "ode_rheonomic",
-                             "reference_rheonomic"};
-    for (int k = 0; k < 4; ++k) {
-      gp << (k ? ", " : "") << "$data using (strcol(1) eq '" << methods[k]
-         << "' ? $7 : 1/0):(($6 > 1e-4) ? $6 : 1e-4) with linespoints lw 2 pt 7 title '"
-         << methods[k] << "'";
-    }
-    gp << ", " << kTargetError << " with lines dt 2 lc rgb 'gray' title '5 % error'\n";
-    plotPng(gp.str(), {{"data", csv.str()}}, (out / "study.png").string());
-    std::printf("%s\nwrote %s/study.{csv,md,png}\n", md.str().c_str(), out_dir.c_str());
+    const Scene scene = scene_arg == "track"    ? vibratingTrackScene()
+                        : scene_arg == "trough" ? troughScene()
+                        : scene_arg == "heap"   ? troughScene(40, true)
+                        : scene_arg == "hopper" ? linearTroughScene()
+                                                : loadScene(scene_arg);
+    const std::string md = rheofeed::demo::runStudy(scene, options);
+    std::printf("%s\nwrote %s/study.{csv,md,png}\n", md.c_str(), options.out_dir.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "feeder_study: %s\n", e.what());
     return 2;

@@ -8,8 +8,9 @@
 #   pkg-config       a C program compiled with cc and plain `pkg-config --cflags --libs rheofeed`,
 #                    and again with `pkg-config --static` (a fully static program, cc -static,
 #                    cannot link: Debian's ode.pc lacks the -lccd that libode.a needs)
-# and checks that the plugin's public headers include no Eigen, nlohmann-json or assimp header
-# and that the README quotes consumer/integration.cpp exactly. Run with cmake -P and
+# and checks that the plugin's public headers include no Eigen, nlohmann-json or assimp header,
+# that the README quotes consumer/integration.cpp exactly, and that the installed `rheofeed`
+# command checks and runs a shipped scene (with meshes) from the prefix. Run with cmake -P and
 #   -DBUILD_DIR=<rheofeed build> -DSOURCE_DIR=<tests/install> -DWORK_DIR=<scratch dir>
 foreach(var BUILD_DIR SOURCE_DIR WORK_DIR)
   if(NOT DEFINED ${var})
@@ -115,3 +116,15 @@ if(leaked)
 endif()
 list(LENGTH headers n_headers)
 message(STATUS "${n_headers} plugin headers include no Eigen, nlohmann-json or assimp header")
+
+# 5. The installed `rheofeed` command finds the installed scenes and meshes (share/rheofeed,
+#    relative to bin/): the bowl's scene names its meshes as ../meshes/*.
+#    Only when the demos (and so the command) are built: -DWITH_CLI=ON.
+if(WITH_CLI)
+  set(rheofeed_cli "${prefix}/bin/rheofeed")
+  run_step("${rheofeed_cli}" check bowl_feeder)
+  run_step("${rheofeed_cli}" run bowl_feeder --duration 1.2 --no-animation --out "${WORK_DIR}/run")
+  if(NOT EXISTS "${WORK_DIR}/run/ode_rheonomic.json")
+    message(FATAL_ERROR "${rheofeed_cli} run bowl_feeder wrote no ${WORK_DIR}/run/ode_rheonomic.json")
+  endif()
+endif()

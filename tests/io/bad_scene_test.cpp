@@ -332,6 +332,12 @@ TEST(SceneLimits, SurfaceLayerBeyondTheSizeBoundIsRefused) {
           "solver.surface_layer", {"10000", "[0, 1000] m"});
 }
 
+TEST(SceneLimits, RheonomicTimeStepOutsideTheStepRangeIsRefused) {
+  refused(replaced(kGood, R"("surface_layer": 1e-4)",
+                   R"("surface_layer": 1e-4, "rheonomic_time_step": 1e-9)"),
+          "solver.rheonomic_time_step", {"1e-09", "[1e-06, 1]"});
+}
+
 // ---- Scene files: kinds, sizes, contents
 // ---------------------------------------------------------
 

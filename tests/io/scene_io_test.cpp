@@ -148,6 +148,7 @@ void expectSameScene(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.solver.coulomb_iterations, b.solver.coulomb_iterations);
   EXPECT_EQ(a.solver.max_correcting_velocity, b.solver.max_correcting_velocity);
   EXPECT_EQ(a.solver.surface_layer, b.solver.surface_layer);
+  EXPECT_EQ(a.solver.rheonomic_time_step, b.solver.rheonomic_time_step);
   EXPECT_EQ(a.removal_height, b.removal_height);
   const Outputs &oa = a.outputs, &ob = b.outputs;
   expectSame(oa.conveying_direction, ob.conveying_direction, "conveying_direction");
@@ -169,6 +170,7 @@ Scene everyFieldScene() {
   s.removal_height = -0.75;
   s.solver.max_correcting_velocity = 0.25;
   s.solver.surface_layer = 2e-4;
+  s.solver.rheonomic_time_step = 0.004;  // written only when given (> 0)
   s.solver.coulomb_iterations = 3;
   s.duration = 2.5;
   s.seed = 18446744073709551557ull;  // needs all 64 bits

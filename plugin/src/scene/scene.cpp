@@ -270,6 +270,16 @@ void Scene::validate() const {
         "with solver.time_step = " + show(solver.time_step) + " s would take " + show(steps) +
             " steps; at most " + show(limits::kMaxSteps) + " steps are allowed");
   }
+  if (solver.rheonomic_time_step != 0) {
+    within("solver.rheonomic_time_step", solver.rheonomic_time_step, limits::kMinTimeStep,
+           limits::kMaxTimeStep, "s");
+    if (const double steps = duration / solver.rheonomic_time_step; !(steps <= limits::kMaxSteps)) {
+      bad("duration", duration,
+          "with solver.rheonomic_time_step = " + show(solver.rheonomic_time_step) +
+              " s would take " + show(steps) + " steps; at most " + show(limits::kMaxSteps) +
+              " steps are allowed");
+    }
+  }
   if (solver.iterations < 1 || solver.iterations > limits::kMaxIterations) {
     bad("solver.iterations", solver.iterations,
         "must be in [1, " + std::to_string(limits::kMaxIterations) + "]");

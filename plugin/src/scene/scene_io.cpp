@@ -703,6 +703,7 @@ Scene readScene(const json& root) {
     Object m(*v, "solver");
     SolverSettings& x = s.solver;
     m.opt("time_step", x.time_step, Range::Positive);
+    m.opt("rheonomic_time_step", x.rheonomic_time_step, Range::NonNegative);
     m.opt("iterations", x.iterations, 1);
     m.opt("ode_quickstep", x.ode_quickstep);
     m.opt("erp", x.erp, Range::UnitInterval);

@@ -208,6 +208,13 @@ struct SolverSettings {
   /// orbit of its own (parts at 0.26x or 1.3x the drift of their neighbours, depending on ERP;
   /// 1e-4 m removes it in the trough scenes of builtin_scenes.hpp).
   double surface_layer = 0.0;
+  /// Time step (s) of the rheonomic runs (ode_rheonomic, reference_rheonomic) when it differs
+  /// from time_step, which then is the full-vibration step of a scene with a vibrating feeder
+  /// (a rheonomic run of such a scene takes tens to hundreds of times larger steps). 0: the
+  /// rheonomic runs take time_step too. Else in [1e-6, 1], with the duration limits of
+  /// time_step. Read by the runners (the `rheofeed` command), not by makeSimulation, which
+  /// always steps with time_step.
+  double rheonomic_time_step = 0;
 };
 
 /// The four methods.

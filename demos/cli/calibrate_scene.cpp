@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: MIT
+#include "cli/calibrate_scene.hpp"
+
+#include <sstream>
+#include <stdexcept>
+
+#include "rheofeed/scene/calibration.hpp"
+
+namespace rheofeed::cli {
+
+using namespace rheofeed::scene;
+
+namespace {
+
+// True when fixture `f`'s drift model lacks what it needs (scene.hpp DriftModel).
+bool lacksCalibration(const Fixture& f) {
+  if (f.law.kind != FeederLaw::Kind::Vibration) return false;
+  switch (f.law.drift_model) {
+    case DriftModel::Local:
+      return false;
+    case DriftModel::LocalSampled:
+      return f.law.efficiency.empty();
+    case DriftModel::CalibratedDrift:
+      return !f.law.has_calibrated_drift;
+  }
+  return false;
+}
+
+}  // namespace
+
+void overrideDriftModel(Scene& scene, const std::string& name) {
+  DriftModel model = DriftModel::Local;
+  if (!parseDriftModel(name, model)) {
+    throw std::invalid_argument("--drift-model " + name +
+                                ": unknown drift model; valid drift models: local, "
+                                "local_sampled, calibrated_drift");
+  }
+  for (Fixture& f : scene.fixtures) {
+    if (f.law.kind != FeederLaw::Kind::Vibration || f.law.drift_model == model) continue;
+    f.law.drift_model = model;
+    f.law.efficiency.clear();  // the scene's factors belong to its own local_sampled
+  }
+}
+
+bool needsCalibration(const Scene& scene) {
+  for (const Fixture& f : scene.fixtures) {
+    if (lacksCalibration(f)) return true;
+  }
+  return false;
+}
+
+CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
+                               const std::string& label, std::FILE* log) {
+  CalibrateReport report;
+  for (std::size_t i = 0; i < scene.fixtures.size(); ++i) {
+    const FeederLaw law = scene.fixtures[i].law;
+    if (law.kind != FeederLaw::Kind::Vibration) continue;
+    const int fixture = static_cast<int>(i);
+    const std::string& name = scene.fixtures[i].name;
+    if (law.drift_model == DriftModel::Local) {
+      std::fprintf(log,
+                   "%s: fixture '%s': drift model local (the local vibration law), nothing "
+                   "to calibrate\n",
+                   label.c_str(), name.c_str());
+      ++report.local;
+      continue;
+    }
+    if (!lacksCalibration(scene.fixtures[i]) && !options.force) {
+      std::fprintf(log, "%s: fixture '%s': drift model %s, given by the scene\n", label.c_str(),
+                   name.c_str(), toString(law.drift_model));
+      ++report.given;
+      continue;
+    }
+    std::ostringstream line;
+    if (law.drift_model == DriftModel::CalibratedDrift) {
+      std::fprintf(
+          log, "%s: calibrating fixture '%s' (drift model calibrated_drift, %s)...\n",
+          label.c_str(), name.c_str(),
+          options.classical ? "classical single-part model" : "short full-vibration sample run");
+      std::fflush(log);
+      const Calibration c = options.classical ? calibrateClassical(scene, fixture)
+                                              : calibrateBySampling(scene, fixture);
+      line << "fixture '" << name << "': calibrated_drift ";
+      if (law.vibration.torsion_amplitude > 0) {
+        line << c.value << " +- " << c.ci95 << " rad/s";
+      } else {
+        line << c.value << " +- " << c.ci95 << " m/s (efficiency " << c.efficiency << ")";
+      }
+      line << ", " << c.how << ", " << c.cpu_seconds << " s CPU";
+      report.cpu_seconds += c.cpu_seconds;
+      scene = withCalibration(scene, c);
+    } else {  // local_sampled: each part family's own efficiency under the local law
+      if (options.classical) {
+        throw std::invalid_argument(
+            "--classical: fixture '" + name +
+            "' has drift model local_sampled, whose efficiency only a sampling run measures; "
+            "drop --classical or use --drift-model calibrated_drift");
+      }
+      EfficiencySettings settings;
+      settings.rheonomic_time_step = options.rheonomic_time_step;
+      Scene sampled = scene;
+      sampled.fixtures[i].law.efficiency.clear();
+      for (std::size_t k = 0; k < scene.parts.size(); ++k) {
+        std::fprintf(log,
+                     "%s: calibrating fixture '%s', part family '%s' (drift model "
+                     "local_sampled: full-vibration sample at %d steps per cycle against the "
+                     "local law at h = %g s)...\n",
+                     label.c_str(), name.c_str(), scene.parts[k].name.c_str(),
+                     settings.steps_per_cycle, settings.rheonomic_time_step);
+        std::fflush(log);
+        const EfficiencyCalibration c =
+            calibrateEfficiency(sampled, fixture, static_cast<int>(k), settings);
+        line << (k ? "; " : "") << "fixture '" << name << "', family '" << scene.parts[k].name
+             << "': efficiency " << c.efficiency << " +- " << c.ci95 << " (" << c.how << ", "
+             << c.cpu_seconds << " s CPU)";
+        report.cpu_seconds += c.cpu_seconds;
+        sampled = withEfficiency(sampled, c);
+      }
+      scene = sampled;
+    }
+    std::fprintf(log, "%s: %s\n", label.c_str(), line.str().c_str());
+    report.summary += line.str() + "\n";
+    ++report.calibrated;
+  }
+  return report;
+}
+
+}  // namespace rheofeed::cli

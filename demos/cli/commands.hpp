@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: MIT
+// The subcommands of `rheofeed` (main.cpp parses the command line). Each returns the process exit
+// code: 0 success, 2 bad input (a message on stderr naming the value, where it came from and the
+// allowed range; nothing has run), 1 a failure while running (e.g. an output that cannot be
+// written); `check` returns 1 when the scene has hazards.
+#pragma once
+
+#include <string>
+
+#include "cli/calibrate_scene.hpp"
+#include "cli/run_plan.hpp"
+
+namespace rheofeed::cli {
+
+/// `rheofeed run SCENE`: runs every method, writes <method>.csv/.json/.png, methods.png,
+/// mean_height.png and, with `animation`, <first method>.glb and view.html into `out`. Prints a
+/// table on stdout; its last line names view.html when it was written.
+struct RunArgs {
+  SceneArgs scene;
+  std::string out;  ///< output folder (out_given); else out/<scene name>
+  bool out_given = false;
+  bool animation = true;
+  CalibrateOptions calibrate;
+};
+int runCommand(const RunArgs& args);
+
+/// `rheofeed check SCENE`: loads and validates the scene, then prints the hazards of the scene
+/// check (check.hpp) for each method at the step it would take. Exit code 0 when there is no
+/// hazard, 1 when there is one (printed on stdout), 2 when the scene or the command line is
+/// invalid.
+int checkCommand(const SceneArgs& args);
+
+/// `rheofeed calibrate SCENE --out NEW.json`: calibrates the vibrating fixtures and writes the
+/// scene with their calibrated drift (scene_io toJson) to `out`, mesh paths relative to its
+/// folder, so that later runs of NEW.json start at once.
+struct CalibrateArgs {
+  SceneArgs scene;
+  std::string out;
+  CalibrateOptions calibrate;
+};
+int calibrateCommand(const CalibrateArgs& args);
+
+/// `rheofeed study SCENE`: the error-vs-cost study (demos/common/study.hpp) of the scene.
+struct StudyArgs {
+  SceneArgs scene;
+  std::string out;  ///< output folder (out_given); else out/<scene name>_study
+  bool out_given = false;
+  int seeds = 3;
+  bool quick = false;
+};
+int studyCommand(const StudyArgs& args);
+
+}  // namespace rheofeed::cli

@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: MIT
+// `rheofeed`: the feeder engineer's command. Subcommands
+//   rheofeed run SCENE        run a scene (methods, step, duration, seed, output folder),
+//                             write CSV/JSON/plots and an animation (run.glb + view.html)
+//   rheofeed calibrate SCENE  calibrate the vibrating feeders, write the scene with the result
+//   rheofeed check SCENE      validate the scene and print the hazards of the scene check
+//   rheofeed study SCENE      the error-vs-cost study (rheonomic vs full vibration)
+// SCENE is the name of a shipped scene (demos/scenes, installed in share/rheofeed/scenes; see
+// shipped_scenes.hpp) or a scene file. Exit codes: 0 success, 1 a failure while running (check:
+// the scene has hazards), 2 bad input (command line or scene; nothing has run).
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <string>
+
+#include "cli/commands.hpp"
+#include "cli/shipped_scenes.hpp"
+
+namespace {
+
+using namespace rheofeed::cli;
+
+std::string shippedList() {
+  std::string names;
+  for (const std::string& n : shippedSceneNames()) names += (names.empty() ? "" : ", ") + n;
+  return names.empty() ? std::string("none found") : names;
+}
+
+// The options every subcommand that loads a scene takes.
+void addSceneArgs(CLI::App* sub, SceneArgs& a, bool with_methods, bool with_overrides,
+                  bool with_drift_model) {
+  sub->add_option("SCENE", a.scene,
+                  "a shipped scene (" + shippedList() +
+                      ") or a scene file (a path with a '/' or ending in .json)")
+      ->required();
+  if (with_drift_model) {
+    sub->add_option("--drift-model", a.drift_model,
+                    "what the rheonomic runs use instead of a feeder's vibration, for every "
+                    "vibrating feeder: local (the local vibration law, no calibration), "
+                    "local_sampled (the local law times each part family's efficiency, measured "
+                    "by a short sampling run unless the scene gives it), calibrated_drift (one "
+                    "constant drift twist, calibrated unless the scene gives it)")
+        ->default_str("each feeder's drift_model in the scene");
+  }
+  if (with_methods) {
+    sub->add_option("--method", a.methods, "methods, repeated or comma-separated: " + methodNames())
+        ->delimiter(',');
+  }
+  if (!with_overrides) return;
+  sub->add_option("--dt", a.dt,
+                  "time step (s) of EVERY run (rheonomic and full-vibration alike); without it "
+                  "a rheonomic run takes the scene's solver.rheonomic_time_step (or its "
+                  "solver.time_step when it gives none) and a full-vibration run the scene's "
+                  "solver.time_step. Finite, in [1e-6, 1] s")
+      ->default_str("scene's step")
+      ->each([&a](const std::string&) { a.dt_given = true; });
+  sub->add_option("--duration", a.duration, "simulated time (s), finite, > 0")
+      ->default_str("scene's duration")
+      ->each([&a](const std::string&) { a.duration_given = true; });
+  sub->add_option("--seed", a.seed,
+                  "random seed of the part sizes, positions and orientations (an integer >= 0)")
+      ->default_str("scene's seed")
+      ->each([&a](const std::string&) { a.seed_given = true; });
+}
+
+void addCalibrateOptions(CLI::App* sub, CalibrateOptions& c) {
+  sub->add_flag("--classical", c.classical,
+                "calibrate with the classical single-part model (milliseconds, a straight-track "
+                "estimate) instead of a short full-vibration sample run")
+      ->default_str("off");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "rheofeed: vibratory feeders, belts and turntables at large time steps (ODE + "
+      "rheonomic contacts)"};
+  app.set_version_flag("--version", std::string("rheofeed ") + RHEOFEED_VERSION);
+  app.require_subcommand(1);
+  app.footer(
+      "Exit codes: 0 success; 1 a failure while running (check: hazards found); 2 bad "
+      "input (command line or scene), nothing has run.\nShipped scenes (" +
+      (dataDir() / "scenes").string() + "): " + shippedList());
+
+  RunArgs run;
+  CLI::App* run_cmd = app.add_subcommand("run", "run a scene and write its outputs");
+  addSceneArgs(run_cmd, run.scene, true, true, true);
+  run_cmd->get_option("--method")->default_str("ode_rheonomic");
+  run_cmd->add_option("--out", run.out, "output folder")
+      ->default_str("out/<scene name>")
+      ->each([&run](const std::string&) { run.out_given = true; });
+  bool no_animation = false;
+  run_cmd
+      ->add_flag("--no-animation", no_animation,
+                 "do not write the animation; by default the first method's run is written as "
+                 "<method>.glb (glTF 2.0, opens in Blender) and view.html, which plays it in a "
+                 "browser beside the plots")
+      ->default_str("off");
+  addCalibrateOptions(run_cmd, run.calibrate);
+
+  CalibrateArgs cal;
+  CLI::App* cal_cmd = app.add_subcommand(
+      "calibrate",
+      "calibrate the drift of the scene's vibrating feeders and write the scene with it, so "
+      "that later runs start at once");
+  addSceneArgs(cal_cmd, cal.scene, false, false, true);
+  cal_cmd->add_option("--out", cal.out, "the new scene file (.json)")->required();
+  addCalibrateOptions(cal_cmd, cal.calibrate);
+  cal_cmd
+      ->add_flag("--force", cal.calibrate.force,
+                 "calibrate also the feeders whose drift the scene already gives")
+      ->default_str("off");
+
+  SceneArgs check;
+  CLI::App* check_cmd = app.add_subcommand(
+      "check",
+      "validate a scene and print the hazards of the scene check for each method at the step it "
+      "takes (exit code 0: none, 1: hazards, 2: invalid)");
+  addSceneArgs(check_cmd, check, true, true, true);
+  check_cmd->get_option("--method")
+      ->default_str("ode_rheonomic, and ode_full_vibration when a feeder vibrates");
+
+  StudyArgs study;
+  CLI::App* study_cmd = app.add_subcommand(
+      "study", "the error-vs-cost study: rheonomic vs full vibration over a sweep of steps");
+  addSceneArgs(study_cmd, study.scene, false, false, false);
+  study_cmd->add_option("--out", study.out, "output folder")
+      ->default_str("out/<scene name>_study")
+      ->each([&study](const std::string&) { study.out_given = true; });
+  study_cmd->add_option("--seeds", study.seeds, "seeds of the converged reference")
+      ->check(CLI::Range(1, 50))
+      ->capture_default_str();
+  study_cmd->add_flag("--quick", study.quick, "coarser sweeps and a shorter reference")
+      ->default_str("off");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;  // --help and --version: 0; any bad command line: 2
+  }
+  run.animation = !no_animation;
+  if (run_cmd->parsed()) return runCommand(run);
+  if (cal_cmd->parsed()) return calibrateCommand(cal);
+  if (check_cmd->parsed()) return checkCommand(check);
+  if (study_cmd->parsed()) return studyCommand(study);
+  return 2;
+}

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: MIT
+#include "cli/run_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+#include "cli/calibrate_scene.hpp"
+#include "cli/shipped_scenes.hpp"
+#include "rheofeed/scene/scene_io.hpp"
+
+namespace rheofeed::cli {
+
+using namespace rheofeed::scene;
+
+namespace {
+
+constexpr Method kMethods[] = {Method::OdeRheonomic, Method::OdeFullVibration,
+                               Method::ReferenceRheonomic, Method::ReferenceFullVibration};
+
+void requirePositiveFinite(const std::string& option, double value) {
+  if (!(value > 0) || !std::isfinite(value)) {
+    throw std::invalid_argument(option + " = " + number(value) +
+                                " s: must be a finite number > 0 (s)");
+  }
+}
+
+}  // namespace
+
+std::string number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+std::string methodNames() {
+  std::string names;
+  for (Method m : kMethods) names += (names.empty() ? "" : ", ") + std::string(toString(m));
+  return names;
+}
+
+Method parseMethod(const std::string& name) {
+  for (Method m : kMethods) {
+    if (name == toString(m)) return m;
+  }
+  throw std::invalid_argument("--method " + name +
+                              ": unknown method; valid methods: " + methodNames());
+}
+
+double sceneStep(const Scene& scene, Method method, std::string* source) {
+  if (!isFullVibration(method) && scene.solver.rheonomic_time_step > 0) {
+    if (source) *source = "the scene's solver.rheonomic_time_step";
+    return scene.solver.rheonomic_time_step;
+  }
+  if (source) *source = "the scene's solver.time_step";
+  return scene.solver.time_step;
+}
+
+Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_methods) {
+  // The command line first (cheap, and a typo is reported before a scene is read).
+  std::vector<Method> methods;
+  for (const std::string& m : args.methods.empty() ? default_methods : args.methods) {
+    methods.push_back(parseMethod(m));
+  }
+  if (args.dt_given) {
+    requirePositiveFinite("--dt", args.dt);
+  }
+  if (args.duration_given) requirePositiveFinite("--duration", args.duration);
+  if (!args.drift_model.empty()) {
+    Scene probe;  // the name is checked before the scene is read
+    overrideDriftModel(probe, args.drift_model);
+  }
+
+  Plan plan;
+  plan.file = resolveScene(args.scene);
+  plan.name = plan.file.stem().string();
+  plan.scene = loadScene(plan.file);
+  Scene& scene = plan.scene;
+  if (args.duration_given) scene.duration = args.duration;
+  if (args.seed_given) scene.seed = args.seed;
+  if (!args.drift_model.empty()) overrideDriftModel(scene, args.drift_model);
+  const std::string where =
+      "scene " + plan.file.string() +
+      (args.duration_given ? " with --duration " + number(args.duration) + " s" : std::string());
+  try {
+    scene.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(where + ": " + e.what());
+  }
+  for (Method m : methods) {
+    PlannedRun run;
+    run.method = m;
+    run.scene = scene;
+    double h = sceneStep(scene, m, &run.step_source);
+    if (args.dt_given) {
+      h = args.dt;
+      run.step_source = "--dt";
+    }
+    run.scene.solver.time_step = h;
+    run.scene.solver.rheonomic_time_step = 0;  // this run's step is time_step now
+    run.scene.outputs.sample_interval = std::max(run.scene.outputs.sample_interval, h);
+    try {
+      run.scene.validate();
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("method ") + toString(m) + " at h = " + number(h) +
+                                  " s (" + run.step_source + "), " + where + ": " + e.what());
+    }
+    plan.runs.push_back(std::move(run));
+  }
+  return plan;
+}
+
+void prepareOutputFolder(const std::filesystem::path& folder, const std::string& option) {
+  if (folder.empty()) {
+    throw std::invalid_argument(option + " \"\": must name an output folder (not empty)");
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(folder, ec);
+  if (ec || !std::filesystem::is_directory(folder)) {
+    throw std::invalid_argument(
+        option + " " + folder.string() + ": cannot create the output folder (" +
+        (ec ? ec.message() : std::string("exists and is not a folder")) + ")");
+  }
+  const std::filesystem::path probe = folder / ".rheofeed_write_test";
+  std::FILE* f = std::fopen(probe.string().c_str(), "w");
+  if (!f) {
+    throw std::invalid_argument(option + " " + folder.string() +
+                                ": the output folder is not writable");
+  }
+  std::fclose(f);
+  std::filesystem::remove(probe, ec);
+}
+
+}  // namespace rheofeed::cli
