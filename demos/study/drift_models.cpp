@@ -138,6 +138,85 @@ std::string lossNote(const RunHealth& h) {
   return " (" + std::to_string(h.partsLost()) + " parts lost)";
 }
 
+// Writes drift_models.{csv,md,png} for the scenes done so far (after every scene, so a long
+// study leaves its results behind as it goes). False (message on stderr) if a file could not
+// be written.
+bool writeOutputs(const DriftModelStudyOptions& o, const std::vector<SceneResult>& results,
+                  bool final) {
+  // Outputs: CSV (one row per scene and model), markdown table, error bar chart.
+  std::ostringstream csv, md, bars;
+  csv << "scene,model,drift,ci95,reference,reference_ci95,error,run_cpu_s,calibration_cpu_s,"
+         "reference_cpu_s,parts_lost,note\n";
+  md << "Drift models against full vibration (ODE, or the reference engine where marked, "
+     << (o.quick ? 400 : o.reference_steps_per_cycle) << " steps/cycle"
+     << (o.quick ? ", QUICK run" : "")
+     << "); every rheonomic run is ODE + plugin at h = " << o.rheonomic_time_step
+     << " s. Error = (drift - full vibration) / |full vibration|. Cost = CPU of the run plus "
+        "its calibration (sampling runs at the judge's steps per cycle).\n\n"
+     << "| scene | full vibration | local | local + sampled efficiency | sampled constant | "
+        "classical constant |\n|---|---|---|---|---|---|\n";
+  bars << "scene,local,local_sampled,sampled_constant,classical\n";
+  char line[512];
+  for (const SceneResult& r : results) {
+    std::snprintf(line, sizeof line, "| %s | %.4g (%s, %.0f s) |", r.name.c_str(), r.reference,
+                  r.judge == Method::OdeFullVibration ? "ODE" : "reference", r.reference_cpu);
+    md << line;
+    bars << r.name;
+    for (int k = 0; k < kModelCount; ++k) {
+      const ModelResult& m = r.models[k];
+      const double error = m.ran ? (m.drift - r.reference) / std::abs(r.reference) : NAN;
+      std::snprintf(line, sizeof line, "%s,%s,%.8g,%.4g,%.8g,%.4g,%.6g,%.4g,%.4g,%.4g,%d,\"%s\"\n",
+                    r.name.c_str(), kModels[k], m.drift, m.ci95, r.reference, r.reference_ci95,
+                    error, m.run_cpu, m.calibration_cpu, r.reference_cpu, m.health.partsLost(),
+                    m.note.c_str());
+      csv << line;
+      if (m.ran) {
+        std::snprintf(line, sizeof line, " %.4g (%+.1f %%, %.2g s) |", m.drift, 100 * error,
+                      m.run_cpu + m.calibration_cpu);
+      } else {
+        std::snprintf(line, sizeof line, " n/a |");
+      }
+      md << line;
+      bars << "," << (m.ran ? 100 * std::abs(error) : 0.0);
+    }
+    md << "\n";
+    bars << "\n";
+  }
+  md << "\nNotes:\n";
+  for (const SceneResult& r : results) {
+    md << "- " << r.name << ": " << r.what;
+    if (!r.models[1].note.empty()) md << "; local_sampled: " << r.models[1].note;
+    if (!r.models[3].ran && !r.models[3].note.empty()) md << "; classical: " << r.models[3].note;
+    md << "\n";
+  }
+  const std::filesystem::path out(o.out_dir);
+  try {
+    writeFileAtomically(out / "drift_models.csv", csv.str());
+    writeFileAtomically(out / "drift_models.md", md.str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "drift model study: %s\n", e.what());
+    return false;
+  }
+  std::ostringstream gp;
+  gp << "set datafile separator ','\nset style data histograms\nset style histogram clustered "
+        "gap 1\nset style fill solid 0.8 border -1\nset key top left\nset grid ytics\n"
+        "set logscale y\nset yrange [0.1:*]\nset xtics rotate by -30\n"
+        "set ylabel '|drift error| vs full vibration (%)'\n"
+        "set title 'Drift models against full vibration (ODE, rheonomic h = "
+     << o.rheonomic_time_step << " s)'\n"
+     << "plot $data using ($2 > 0.1 ? $2 : 0.1):xtic(1) skip 1 title 'local', '' using ($3 > "
+        "0.1 ? $3 : 0.1) skip 1 title 'local + sampled efficiency', '' using ($4 > 0.1 ? $4 : "
+        "0.1) skip 1 title 'sampled constant', '' using ($5 > 0.1 ? $5 : 0.1) skip 1 title "
+        "'classical constant'\n";
+  if (!plotPng(gp.str(), {{"data", bars.str()}}, (out / "drift_models.png").string())) {
+    std::fprintf(stderr, "drift model study: the plot was not written (gnuplot failed)\n");
+  }
+  if (final) {
+    std::printf("%s\nwrote %s/drift_models.{csv,md,png}\n", md.str().c_str(), o.out_dir.c_str());
+  }
+  return true;
+}
+
 }  // namespace
 
 std::vector<std::string> driftModelStudyScenes() {
@@ -206,8 +285,7 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
         Scene s = scene;
         s.solver.time_step = 1.0 / (f * ref_spc);
         r.reference = mean_over_seeds(
-            s, judge,
-            entry.name + " full vibration " + std::to_string(ref_spc) + " steps/cycle",
+            s, judge, entry.name + " full vibration " + std::to_string(ref_spc) + " steps/cycle",
             &r.reference_ci95, &r.reference_cpu, &r.reference_health);
       }
       std::fprintf(stderr, "%s: full vibration %.6g +- %.2g (%.1f s CPU)%s\n", entry.name.c_str(),
@@ -265,82 +343,14 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
         rheonomic(3, withCalibration(scene, c));
       });
       results.push_back(r);
+      if (!writeOutputs(o, results, false)) return 2;
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "drift model study: %s\n", e.what());
     return 2;
   }
 
-  // Outputs: CSV (one row per scene and model), markdown table, error bar chart.
-  std::ostringstream csv, md, bars;
-  csv << "scene,model,drift,ci95,reference,reference_ci95,error,run_cpu_s,calibration_cpu_s,"
-         "reference_cpu_s,parts_lost,note\n";
-  md << "Drift models against full vibration (ODE, or the reference engine where marked, "
-     << (o.quick ? 400 : o.reference_steps_per_cycle) << " steps/cycle"
-     << (o.quick ? ", QUICK run" : "")
-     << "); every rheonomic run is ODE + plugin at h = " << o.rheonomic_time_step
-     << " s. Error = (drift - full vibration) / |full vibration|. Cost = CPU of the run plus "
-        "its calibration (sampling runs at the judge's steps per cycle).\n\n"
-     << "| scene | full vibration | local | local + sampled efficiency | sampled constant | "
-        "classical constant |\n|---|---|---|---|---|---|\n";
-  bars << "scene,local,local_sampled,sampled_constant,classical\n";
-  char line[512];
-  for (const SceneResult& r : results) {
-    std::snprintf(line, sizeof line, "| %s | %.4g (%s, %.0f s) |", r.name.c_str(), r.reference,
-                  r.judge == Method::OdeFullVibration ? "ODE" : "reference", r.reference_cpu);
-    md << line;
-    bars << r.name;
-    for (int k = 0; k < kModelCount; ++k) {
-      const ModelResult& m = r.models[k];
-      const double error = m.ran ? (m.drift - r.reference) / std::abs(r.reference) : NAN;
-      std::snprintf(line, sizeof line, "%s,%s,%.8g,%.4g,%.8g,%.4g,%.6g,%.4g,%.4g,%.4g,%d,\"%s\"\n",
-                    r.name.c_str(), kModels[k], m.drift, m.ci95, r.reference, r.reference_ci95,
-                    error, m.run_cpu, m.calibration_cpu, r.reference_cpu, m.health.partsLost(),
-                    m.note.c_str());
-      csv << line;
-      if (m.ran) {
-        std::snprintf(line, sizeof line, " %.4g (%+.1f %%, %.2g s) |", m.drift, 100 * error,
-                      m.run_cpu + m.calibration_cpu);
-      } else {
-        std::snprintf(line, sizeof line, " n/a |");
-      }
-      md << line;
-      bars << "," << (m.ran ? 100 * std::abs(error) : 0.0);
-    }
-    md << "\n";
-    bars << "\n";
-  }
-  md << "\nNotes:\n";
-  for (const SceneResult& r : results) {
-    md << "- " << r.name << ": " << r.what;
-    if (!r.models[1].note.empty()) md << "; local_sampled: " << r.models[1].note;
-    if (!r.models[3].ran && !r.models[3].note.empty()) md << "; classical: " << r.models[3].note;
-    md << "\n";
-  }
-  const std::filesystem::path out(o.out_dir);
-  try {
-    writeFileAtomically(out / "drift_models.csv", csv.str());
-    writeFileAtomically(out / "drift_models.md", md.str());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "drift model study: %s\n", e.what());
-    return 2;
-  }
-  std::ostringstream gp;
-  gp << "set datafile separator ','\nset style data histograms\nset style histogram clustered "
-        "gap 1\nset style fill solid 0.8 border -1\nset key top left\nset grid ytics\n"
-        "set logscale y\nset yrange [0.1:*]\nset xtics rotate by -30\n"
-        "set ylabel '|drift error| vs full vibration (%)'\n"
-        "set title 'Drift models against full vibration (ODE, rheonomic h = "
-     << o.rheonomic_time_step << " s)'\n"
-     << "plot $data using ($2 > 0.1 ? $2 : 0.1):xtic(1) skip 1 title 'local', '' using ($3 > "
-        "0.1 ? $3 : 0.1) skip 1 title 'local + sampled efficiency', '' using ($4 > 0.1 ? $4 : "
-        "0.1) skip 1 title 'sampled constant', '' using ($5 > 0.1 ? $5 : 0.1) skip 1 title "
-        "'classical constant'\n";
-  if (!plotPng(gp.str(), {{"data", bars.str()}}, (out / "drift_models.png").string())) {
-    std::fprintf(stderr, "drift model study: the plot was not written (gnuplot failed)\n");
-  }
-  std::printf("%s\nwrote %s/drift_models.{csv,md,png}\n", md.str().c_str(), o.out_dir.c_str());
-  return 0;
+  return writeOutputs(o, results, true) ? 0 : 2;
 }
 
 }  // namespace rheofeed::demo
