@@ -56,9 +56,21 @@ void addSceneArgs(CLI::App* sub, SceneArgs& a, bool with_methods, bool with_over
   sub->add_option("--duration", a.duration, "simulated time (s), finite, > 0")
       ->default_str("scene's duration")
       ->each([&a](const std::string&) { a.duration_given = true; });
+  sub->add_option("--warmup", a.warmup,
+                  "time (s) excluded from the mean drift at the start of the run, finite, >= 0 and "
+                  "below the duration (give it with a short --duration)")
+      ->default_str("scene's outputs.warmup")
+      ->each([&a](const std::string&) { a.warmup_given = true; });
   sub->add_option("--seed", a.seed,
                   "random seed of the part sizes, positions and orientations (an integer >= 0)")
       ->default_str("scene's seed")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            return v.find_first_not_of("0123456789") == std::string::npos && !v.empty()
+                       ? std::string()
+                       : "--seed " + v + ": must be an integer >= 0 (decimal digits only)";
+          },
+          ""))
       ->each([&a](const std::string&) { a.seed_given = true; });
 }
 

@@ -69,6 +69,10 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
     requirePositiveFinite("--dt", args.dt);
   }
   if (args.duration_given) requirePositiveFinite("--duration", args.duration);
+  if (args.warmup_given && !(std::isfinite(args.warmup) && args.warmup >= 0)) {
+    throw std::invalid_argument("--warmup = " + number(args.warmup) +
+                                " s: must be a finite number >= 0 s (and below the duration)");
+  }
   if (!args.drift_model.empty()) {
     Scene probe;  // the name is checked before the scene is read
     overrideDriftModel(probe, args.drift_model);
@@ -80,11 +84,13 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
   plan.scene = loadScene(plan.file);
   Scene& scene = plan.scene;
   if (args.duration_given) scene.duration = args.duration;
+  if (args.warmup_given) scene.outputs.warmup = args.warmup;
   if (args.seed_given) scene.seed = args.seed;
   if (!args.drift_model.empty()) overrideDriftModel(scene, args.drift_model);
   const std::string where =
       "scene " + plan.file.string() +
-      (args.duration_given ? " with --duration " + number(args.duration) + " s" : std::string());
+      (args.duration_given ? " with --duration " + number(args.duration) + " s" : std::string()) +
+      (args.warmup_given ? " with --warmup " + number(args.warmup) + " s" : std::string());
   try {
     scene.validate();
   } catch (const std::invalid_argument& e) {

@@ -28,6 +28,8 @@ struct SceneArgs {
   bool dt_given = false;
   double duration = 0;  ///< --duration (s), when duration_given
   bool duration_given = false;
+  double warmup = 0;  ///< --warmup (s): time excluded from the mean drift, when warmup_given
+  bool warmup_given = false;
   std::uint64_t seed = 0;  ///< --seed, when seed_given
   bool seed_given = false;
   /// --drift-model: empty keeps each vibrating feeder's drift model; else local, local_sampled
