@@ -106,7 +106,11 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
       run.step_source = "--dt";
     }
     run.scene.solver.time_step = h;
-    run.scene.solver.rheonomic_time_step = 0;  // this run's step is time_step now
+    // This run's step is time_step now; rheonomic_time_step stays (equal to it) only when it is
+    // where the step came from, so that the scene check names the field to change.
+    const bool from_rheonomic_field =
+        !args.dt_given && !isFullVibration(m) && scene.solver.rheonomic_time_step > 0;
+    run.scene.solver.rheonomic_time_step = from_rheonomic_field ? h : 0;
     run.scene.outputs.sample_interval = std::max(run.scene.outputs.sample_interval, h);
     try {
       run.scene.validate();

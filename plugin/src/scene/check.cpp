@@ -368,6 +368,11 @@ std::vector<Hazard> checkScene(const Scene& scene, Method method) {
   const Vec3 up = g > 0 ? (-1.0 / g) * scene.gravity : Vec3{0, 0, 1};
   const bool full = isFullVibration(method);
   const bool ode = method == Method::OdeRheonomic || method == Method::OdeFullVibration;
+  // The scene field that sets this method's step: a rheonomic run of a scene that gives
+  // solver.rheonomic_time_step takes it (rheofeed run), every other run solver.time_step.
+  const std::string step_field = !full && scene.solver.rheonomic_time_step > 0
+                                     ? "solver.rheonomic_time_step"
+                                     : "solver.time_step";
 
   // Parts: the thinnest, the lightest and the heaviest over all families.
   double thinnest_part = kInf, lightest = kInf, heaviest = 0, light_thickness = kInf;
@@ -530,7 +535,7 @@ std::vector<Hazard> checkScene(const Scene& scene, Method method) {
       hz.value = travel;
       hz.limit = allowed;
       const bool fixture_thinner = thinnest_fixture <= thinnest_part;
-      hz.where = "solver.time_step, " + idx("parts", thin_family) + ".size" +
+      hz.where = step_field + ", " + idx("parts", thin_family) + ".size" +
                  (fixture_thinner ? ", " + thin_geom : "");
       std::ostringstream m;
       m << "a part at the expected speed " << fmt(speed) << " m/s (" << source
@@ -546,7 +551,7 @@ std::vector<Hazard> checkScene(const Scene& scene, Method method) {
       const double safe_h =
           g > 0 ? (-speed + std::sqrt(speed * speed + 4 * g * allowed)) / (2 * g) : allowed / speed;
       std::ostringstream s;
-      s << "solver.time_step <= " << fmt(safe_h) << " s";
+      s << step_field << " <= " << fmt(safe_h) << " s";
       if (fixture_thinner) {
         s << ", or make " << thin_geom << " at least "
           << mm(std::max(0.0, 2 * travel - thinnest_part)) << " thick";
@@ -640,7 +645,7 @@ std::vector<Hazard> checkScene(const Scene& scene, Method method) {
            ++n) {
         safe_h *= 0.8;
       }
-      s << "solver.time_step <= " << fmt(safe_h) << " s";
+      s << step_field << " <= " << fmt(safe_h) << " s";
       if (quickstep) s << ", or solver.ode_quickstep = false (Dantzig LCP, exact but slower)";
       s << ", or parts of closer masses";
       hz.safe_setting = s.str();
