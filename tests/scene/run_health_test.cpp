@@ -341,7 +341,7 @@ TEST(RunHealth, JsonAndCsvCarryTheCounts) {
   const nlohmann::json& h = j.at("health");
   EXPECT_EQ(h.at("parts_fell").get<int>(), 1);
   EXPECT_EQ(h.at("parts_lost").get<int>(), 1);
-  EXPECT_EQ(h.at("parts_exited").get<int>(), 0);
+  EXPECT_EQ(h.at("parts_removed_after_exit").get<int>(), 0);
   EXPECT_EQ(h.at("parts_through_fixture").get<int>(), 0);
   EXPECT_EQ(h.at("parts_out_of_bounds").get<int>(), 0);
   EXPECT_EQ(h.at("parts_nonfinite").get<int>(), 0);

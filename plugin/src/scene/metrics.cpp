@@ -493,7 +493,7 @@ std::string summaryJson(const RunMetrics& r) {
   const RunHealth& h = r.health;
   char c[1536];
   std::snprintf(c, sizeof c,
-                ", \"health\": {\"steps\": %ld, \"parts_exited\": %d, \"parts_lost\": %d, "
+                ", \"health\": {\"steps\": %ld, \"parts_removed_after_exit\": %d, \"parts_lost\": %d, "
                 "\"parts_fell\": %d, \"parts_through_fixture\": %d, \"parts_out_of_bounds\": %d, "
                 "\"parts_nonfinite\": %d, \"parts_too_fast\": %d, \"parts_inside_fixture\": %d, "
                 "\"parts_sunk\": %d, "
