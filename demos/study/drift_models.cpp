@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -24,9 +25,12 @@ using namespace rheofeed::scene;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180;
 
-// The four drift models of the comparison, in table order.
-const char* const kModels[] = {"local", "local_sampled", "sampled_constant", "classical"};
-constexpr int kModelCount = 4;
+// The drift models of the comparison, in table order.
+// "level_constant": the sampled constant of track_level reused on the other tracks (what a user
+// who calibrated once on a level track gets on an incline or a cross slope).
+const char* const kModels[] = {"local", "local_sampled", "sampled_constant", "classical",
+                               "level_constant"};
+constexpr int kModelCount = 5;
 
 // A scene of the comparison: how to build it, what its drift is measured as.
 struct StudyScene {
@@ -162,8 +166,9 @@ bool writeOutputs(const DriftModelStudyOptions& o, const std::vector<SceneResult
         "full vibration) / |full vibration|. Cost = CPU of the run plus "
         "its calibration (sampling runs at the judge's steps per cycle).\n\n"
      << "| scene | full vibration | local | local + sampled efficiency | sampled constant | "
-        "classical constant |\n|---|---|---|---|---|---|\n";
-  bars << "scene,local,local_sampled,sampled_constant,classical\n";
+        "classical constant | constant sampled on the level track "
+        "|\n|---|---|---|---|---|---|---|\n";
+  bars << "scene,local,local_sampled,sampled_constant,classical,level_constant\n";
   char line[512];
   for (const SceneResult& r : results) {
     std::snprintf(line, sizeof line, "| %s | %.4g (%s, %d steps/cycle, %.0f s) |", r.name.c_str(),
@@ -216,7 +221,8 @@ bool writeOutputs(const DriftModelStudyOptions& o, const std::vector<SceneResult
      << "plot $data using ($2 > 0.1 ? $2 : 0.1):xtic(1) skip 1 title 'local', '' using ($3 > "
         "0.1 ? $3 : 0.1) skip 1 title 'local + sampled efficiency', '' using ($4 > 0.1 ? $4 : "
         "0.1) skip 1 title 'sampled constant', '' using ($5 > 0.1 ? $5 : 0.1) skip 1 title "
-        "'classical constant'\n";
+        "'classical constant', '' using ($6 > 0.1 ? $6 : 0.1) skip 1 title 'level-track "
+        "constant on this scene'\n";
   if (!plotPng(gp.str(), {{"data", bars.str()}}, (out / "drift_models.png").string())) {
     std::fprintf(stderr, "drift model study: the plot was not written (gnuplot failed)\n");
   }
@@ -255,6 +261,7 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
     }
   }
   std::vector<SceneResult> results;
+  std::optional<Calibration> level_calibration;  // track_level's sampled constant
   try {
     std::filesystem::create_directories(o.out_dir);
     for (const StudyScene& entry : scenes) {
@@ -351,8 +358,16 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
         if (o.quick) cs.measure_cycles = 40;
         const Calibration c = calibrateBySampling(scene, fixture, cs);
         r.models[2].calibration_cpu = c.cpu_seconds;
+        if (entry.name == "track_level") level_calibration = c;
         rheonomic(2, withCalibration(scene, c));
       });
+      if (level_calibration && entry.name.rfind("track_", 0) == 0 && entry.name != "track_level") {
+        attempt(4, [&] {
+          r.models[4].calibration_cpu = level_calibration->cpu_seconds;
+          r.models[4].note = "sampled on track_level";
+          rheonomic(4, withCalibration(scene, *level_calibration));
+        });
+      }
       attempt(3, [&] {
         const Calibration c = calibrateClassical(scene, fixture);
         r.models[3].calibration_cpu = c.cpu_seconds;

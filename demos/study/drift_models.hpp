@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
 // The drift-model comparison of the study (issue 8): on each scene, the drift error and the cost
-// of the four ways a rheonomic run can replace a feeder's vibration,
+// of the ways a rheonomic run can replace a feeder's vibration,
 //   local            the local vibration law, no sampling run (vibration_drift.hpp)
 //   local_sampled    the local law times the part family's own efficiency (one sampling run)
 //   sampled_constant one constant drift twist from a full-vibration sampling run
 //   classical        one constant drift twist from the classical single-part model
+//   level_constant   (tracks) the sampled constant of the level track reused on this track
 // against the judge, ODE full vibration of the same scene at `reference_steps_per_cycle`. Every
 // rheonomic run is ODE + plugin at h = `rheonomic_time_step`. Scenes: a single flat part on a
 // track that is level, inclined by +-5 and +10 degrees, or tilted 5 degrees sideways (gravity
