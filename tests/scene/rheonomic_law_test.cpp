@@ -181,6 +181,12 @@ TEST(RheonomicLaw, PartEfficiencyScalesTheDriftInBothEngines) {
     EXPECT_EQ(j.at("feeders").get<int>(), 1);
     EXPECT_EQ(j.at("contacts").get<long long>(), a.health.local_law.contacts);
     EXPECT_EQ(j.at("cells_computed").get<long long>(), a.health.local_law.cells_computed);
+    // The run's JSON names what reproduces it: the seed and each vibrating fixture's model.
+    const nlohmann::json run = nlohmann::json::parse(summaryJson(b));
+    EXPECT_EQ(run.at("seed").get<std::uint64_t>(), sampled.seed);
+    ASSERT_EQ(run.at("drift_models").size(), 1u);
+    EXPECT_EQ(run.at("drift_models")[0].get<std::string>(),
+              sampled.fixtures[0].name + ": local_sampled");
   }
 }
 

@@ -191,6 +191,12 @@ RunMetrics measureRun(const Scene& scene, Method method, const Progress& progres
   m.scene = scene.name;
   m.method = method;
   m.time_step = h;
+  m.seed = scene.seed;
+  for (const Fixture& f : scene.fixtures) {
+    if (f.law.kind == FeederLaw::Kind::Vibration) {
+      m.drift_models.push_back(f.name + ": " + toString(f.law.drift_model));
+    }
+  }
   m.angular = out.angular_drift;
   std::vector<Track> tracks;
   int exited_total = 0, exited_after_warmup = 0;
@@ -490,24 +496,30 @@ std::string summaryJson(const RunMetrics& r) {
                 toString(r.method), r.time_step, r.parts, r.angular ? "rad/s" : "m/s", r.mean_drift,
                 r.mean_drift_ci95, r.vertical_displacement, r.throughput, r.cpu_seconds,
                 r.simulated_seconds, r.real_time_factor);
+  std::string run = b;  // the run's own settings: seed and drift models
+  run += ", \"seed\": " + std::to_string(r.seed) + ", \"drift_models\": [";
+  for (std::size_t k = 0; k < r.drift_models.size(); ++k) {
+    run += (k ? ", " : "") + jsonQuoted(r.drift_models[k]);
+  }
+  run += "]";
   const RunHealth& h = r.health;
   char c[1536];
-  std::snprintf(c, sizeof c,
-                ", \"health\": {\"steps\": %ld, \"parts_removed_after_exit\": %d, \"parts_lost\": %d, "
-                "\"parts_fell\": %d, \"parts_through_fixture\": %d, \"parts_out_of_bounds\": %d, "
-                "\"parts_nonfinite\": %d, \"parts_too_fast\": %d, \"parts_inside_fixture\": %d, "
-                "\"parts_sunk\": %d, "
-                "\"coulomb_fallback_steps\": %ld, "
-                "\"coulomb_fallback_share\": %.6g, \"solver_unconverged_steps\": %ld, "
-                "\"friction_dropped_contacts\": %ld, \"gyroscopic_fallback_steps\": %ld, "
-                "\"max_part_speed_mps\": %.6g, \"speed_bound_mps\": %.6g, \"ignored_settings\": [",
-                h.steps, h.parts_exited, h.partsLost(), h.parts_fell, h.parts_through_fixture,
-                h.parts_out_of_bounds, h.parts_nonfinite, h.parts_too_fast, h.parts_inside_fixture,
-                h.parts_sunk, h.coulomb_fallback_steps,
-                h.steps > 0 ? double(h.coulomb_fallback_steps) / h.steps : 0.0,
-                h.solver_unconverged_steps, h.friction_dropped_contacts,
-                h.gyroscopic_fallback_steps, h.max_part_speed, h.speed_bound);
-  std::string json = "{\"scene\": " + jsonQuoted(r.scene) + b + c;
+  std::snprintf(
+      c, sizeof c,
+      ", \"health\": {\"steps\": %ld, \"parts_removed_after_exit\": %d, \"parts_lost\": %d, "
+      "\"parts_fell\": %d, \"parts_through_fixture\": %d, \"parts_out_of_bounds\": %d, "
+      "\"parts_nonfinite\": %d, \"parts_too_fast\": %d, \"parts_inside_fixture\": %d, "
+      "\"parts_sunk\": %d, "
+      "\"coulomb_fallback_steps\": %ld, "
+      "\"coulomb_fallback_share\": %.6g, \"solver_unconverged_steps\": %ld, "
+      "\"friction_dropped_contacts\": %ld, \"gyroscopic_fallback_steps\": %ld, "
+      "\"max_part_speed_mps\": %.6g, \"speed_bound_mps\": %.6g, \"ignored_settings\": [",
+      h.steps, h.parts_exited, h.partsLost(), h.parts_fell, h.parts_through_fixture,
+      h.parts_out_of_bounds, h.parts_nonfinite, h.parts_too_fast, h.parts_inside_fixture,
+      h.parts_sunk, h.coulomb_fallback_steps,
+      h.steps > 0 ? double(h.coulomb_fallback_steps) / h.steps : 0.0, h.solver_unconverged_steps,
+      h.friction_dropped_contacts, h.gyroscopic_fallback_steps, h.max_part_speed, h.speed_bound);
+  std::string json = "{\"scene\": " + jsonQuoted(r.scene) + run + c;
   for (std::size_t k = 0; k < h.ignored_settings.size(); ++k) {
     json += (k ? ", " : "") + jsonQuoted(h.ignored_settings[k]);
   }

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <string>
@@ -119,7 +120,11 @@ struct FeederMetrics {
 struct RunMetrics {
   std::string scene;
   Method method = Method::OdeRheonomic;
-  double time_step = 0;  ///< (s)
+  double time_step = 0;    ///< (s)
+  std::uint64_t seed = 0;  ///< Scene::seed of the run (to reproduce it)
+  /// "fixture name: drift model" of every vibrating fixture (what a rheonomic run used instead
+  /// of the vibration; full-vibration runs ignore it).
+  std::vector<std::string> drift_models;
   bool angular = false;  ///< the drift is an angular velocity (rad/s) instead of m/s
   std::vector<DriftSample> series;
   /// Mean drift (m/s along d, or rad/s about the axis) over [warmup, end]: total displacement of
