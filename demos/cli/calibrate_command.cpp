@@ -69,7 +69,7 @@ int calibrateCommand(const CalibrateArgs& args) {
     std::fprintf(stderr, "rheofeed calibrate: %s\n", e.what());
     return 2;
   }
-  try {
+  return runChecked("rheofeed calibrate", [&] {
     Scene scene = plan.scene;
     CalibrateOptions options = args.calibrate;
     options.rheonomic_time_step = sceneStep(scene, Method::OdeRheonomic, nullptr);
@@ -103,14 +103,7 @@ int calibrateCommand(const CalibrateArgs& args) {
     parseScene(text, out.string());  // the file written reads back (meshes and all)
     writeFileAtomically(out, text);
     std::printf("%swrote %s\n", report.summary.c_str(), out.string().c_str());
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "rheofeed calibrate: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "rheofeed calibrate: failed: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+  });
 }
 
 }  // namespace rheofeed::cli

@@ -5,6 +5,7 @@
 // written); `check` returns 1 when the scene has hazards.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "cli/calibrate_scene.hpp"
@@ -49,5 +50,10 @@ struct StudyArgs {
   bool quick = false;
 };
 int studyCommand(const StudyArgs& args);
+
+/// Runs the part of `command` ("rheofeed run", ...) that comes after its input was checked and
+/// returns the exit code: 0, or with a message on stderr 2 for a std::invalid_argument (bad input
+/// found while running) and 1 for any other exception.
+int runChecked(const char* command, const std::function<void()>& body);
 
 }  // namespace rheofeed::cli

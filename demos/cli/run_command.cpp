@@ -85,7 +85,7 @@ int runCommand(const RunArgs& args) {
     return 2;
   }
 
-  try {
+  return runChecked("rheofeed run", [&] {
     // A rheonomic run of a vibrating feeder needs its drift field: calibrated once, here, when
     // the scene does not give it (`rheofeed calibrate` saves it into the scene).
     bool any_rheonomic = false;
@@ -167,14 +167,7 @@ int runCommand(const RunArgs& args) {
       std::printf("animation (%s): open %s\n", toString(plan.runs[0].method),
                   page.string().c_str());
     }
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "rheofeed run: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "rheofeed run: failed: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+  });
 }
 
 }  // namespace rheofeed::cli

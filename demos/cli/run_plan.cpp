@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "cli/calibrate_scene.hpp"
+#include "cli/commands.hpp"
 #include "cli/shipped_scenes.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 
@@ -142,6 +143,19 @@ void prepareOutputFolder(const std::filesystem::path& folder, const std::string&
   }
   std::fclose(f);
   std::filesystem::remove(probe, ec);
+}
+
+int runChecked(const char* command, const std::function<void()>& body) {
+  try {
+    body();
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "%s: %s\n", command, e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: failed: %s\n", command, e.what());
+    return 1;
+  }
+  return 0;
 }
 
 }  // namespace rheofeed::cli

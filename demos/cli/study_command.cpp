@@ -27,17 +27,10 @@ int studyCommand(const StudyArgs& args) {
     std::fprintf(stderr, "rheofeed study: %s\n", e.what());
     return 2;
   }
-  try {
+  return runChecked("rheofeed study", [&] {
     const std::string md = rheofeed::demo::runStudy(plan.scene, options);
     std::printf("%s\nwrote %s/study.{csv,md,png}\n", md.c_str(), options.out_dir.c_str());
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "rheofeed study: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "rheofeed study: failed: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+  });
 }
 
 }  // namespace rheofeed::cli
