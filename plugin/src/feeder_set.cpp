@@ -294,10 +294,11 @@ void FeederSet::remove(dGeomID geom) {
 }
 
 void FeederSet::setPartEfficiency(dBodyID body, double factor) {
-  if (!body || !(factor >= 0 && factor <= 100)) {
+  const std::string where = "rheofeed::FeederSet::setPartEfficiency: ";
+  if (!body) throw std::invalid_argument(where + "body is null");
+  if (!(factor >= 0 && factor <= kMaxEfficiency)) {
     std::ostringstream out;
-    out << "rheofeed::FeederSet::setPartEfficiency: " << (body ? "factor = " : "body is null");
-    if (body) out << factor << " must be in [0, 100]";
+    out << where << "factor = " << factor << " must be in [0, " << kMaxEfficiency << "]";
     throw std::invalid_argument(out.str());
   }
   impl_->part_efficiency[body] = factor;

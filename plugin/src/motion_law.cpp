@@ -493,11 +493,10 @@ Vec3 StepLaw::tangentialVelocity(const Vec3& p, const Vec3& n) const {
 
 Vec3 StepLaw::contactVelocity(const Vec3& p_contact, const Vec3& n_out, double mu,
                               double efficiency, const Vec3* carried) const {
-  const Vec3 p = carried ? *carried - dot(*carried - p_contact, n_out) * n_out : p_contact;
   if (eval_ != Eval::Local) return tangentialVelocity(p_contact, n_out);
-  if (local_->isTranslation()) {
+  if (local_->isTranslation()) {  // the drift does not depend on the point
     if (!(memo_valid_ && n_out == memo_n_ && mu == memo_mu_)) {
-      memo_value_ = localDrift(*local_, p, n_out, mu, table_, &memo_wall_);
+      memo_value_ = localDrift(*local_, p_contact, n_out, mu, table_, &memo_wall_);
       memo_n_ = n_out;
       memo_mu_ = mu;
       memo_valid_ = true;
@@ -506,6 +505,7 @@ Vec3 StepLaw::contactVelocity(const Vec3& p_contact, const Vec3& n_out, double m
     }
     return (scale_ * efficiency) * memo_value_;
   }
+  const Vec3 p = carried ? *carried - dot(*carried - p_contact, n_out) * n_out : p_contact;
   return (scale_ * efficiency) * localDrift(*local_, p, n_out, mu, table_);
 }
 

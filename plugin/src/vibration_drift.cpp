@@ -177,30 +177,29 @@ PointMassDrift pointMassDrift(const PointMassParams& params, const PointMassSett
   PointMassDrift result;
   result.problem = paramsProblem(params, settings);
   if (!result.problem.empty()) return result;
-  if (params.mu == 0) {  // frictionless and level: nothing in the plane drives the mass
-    result.valid = true;
-    result.flight_fraction = params.normal_throw > 1 ? 1 : 0;
-    return result;
-  }
+  // Frictionless (and so level: paramsProblem): nothing in the plane couples the mass to the
+  // plane's in-plane motion, whose mean relative velocity is zero; only the normal motion (the
+  // flight and stick fractions) is simulated, without the in-plane forcing, and the drift is 0.
+  PointMassParams q = params;
+  if (q.mu == 0) q.tangential_throw = 0;
   // The transient from rest is run at 1/16 of the resolution, then the fine steps start from
   // its steady state and converge in a few cycles (the two steady states are within the
   // coarse step's error): about 8x less work than the fine transient, same result (the fine
   // steady state is found by the same periodicity test).
   CycleState state;
   const int coarse = std::max(16, settings.steps_per_cycle / 16 / 2 * 2);
-  if (coarse < settings.steps_per_cycle) steadyState(params, settings, coarse, state);
-  return steadyState(params, settings, settings.steps_per_cycle, state);
+  if (coarse < settings.steps_per_cycle) steadyState(q, settings, coarse, state);
+  return steadyState(q, settings, settings.steps_per_cycle, state);
 }
 
 void LocalVibration::validate(const std::string& where) const {
   auto fail = [&](const std::string& what) { throw std::invalid_argument(where + ": " + what); };
-  auto finite = [](const Vec3& v) { return isFinite(v); };
   std::ostringstream out;
   if (!(frequency > 0 && frequency <= 1e5)) {
     out << "vibration frequency = " << frequency << " Hz: must be in (0, 1e+05] Hz";
     fail(out.str());
   }
-  if (!finite(amplitude) || !(norm(amplitude) <= 1e3)) {
+  if (!isFinite(amplitude) || !(norm(amplitude) <= 1e3)) {
     out << "vibration |amplitude| = " << norm(amplitude) << " m: must be finite, in [0, 1e+03] m";
     fail(out.str());
   }
@@ -208,14 +207,14 @@ void LocalVibration::validate(const std::string& where) const {
     out << "torsion amplitude = " << torsion_amplitude << " rad: must be in [0, pi] rad";
     fail(out.str());
   }
-  if (!finite(axis_origin) || !finite(axis_direction) ||
+  if (!isFinite(axis_origin) || !isFinite(axis_direction) ||
       !(std::fabs(norm(axis_direction) - 1) <= 1e-6)) {
     out << "torsion axis (origin (" << axis_origin.x << ", " << axis_origin.y << ", "
         << axis_origin.z << ") m, direction |k| = " << norm(axis_direction)
         << "): must be finite with a unit direction";
     fail(out.str());
   }
-  if (!finite(gravity) || !(norm(gravity) > 0)) {
+  if (!isFinite(gravity) || !(norm(gravity) > 0)) {
     out << "gravity |g| = " << norm(gravity) << " m/s^2: must be finite and > 0";
     fail(out.str());
   }
@@ -223,8 +222,8 @@ void LocalVibration::validate(const std::string& where) const {
     out << "mu = " << mu << ": must be in [0, 1e+03]";
     fail(out.str());
   }
-  if (!(efficiency >= 0 && efficiency <= 100)) {
-    out << "efficiency = " << efficiency << ": must be in [0, 100]";
+  if (!(efficiency >= 0 && efficiency <= kMaxEfficiency)) {
+    out << "efficiency = " << efficiency << ": must be in [0, " << kMaxEfficiency << "]";
     fail(out.str());
   }
 }

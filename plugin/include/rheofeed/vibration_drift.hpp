@@ -60,6 +60,11 @@
 
 namespace rheofeed {
 
+/// Largest efficiency factor (dimensionless) of a local law or a part (LocalVibration::efficiency,
+/// FeederSet::setPartEfficiency, reference::World::setBodyEfficiency, scene files): a part 100x
+/// faster than a point mass would be a wrong calibration, not a shape effect.
+constexpr double kMaxEfficiency = 100;
+
 /// The dimensionless inputs of the point-mass model (file comment).
 struct PointMassParams {
   double normal_throw = 0;      ///< Gamma >= 0

@@ -441,9 +441,9 @@ void World::setBodyEfficiency(BodyId body, double factor) {
       impl_->bodies[static_cast<std::size_t>(body)].kinematic) {
     refuse("setBodyEfficiency: body " + std::to_string(body) + " is not a dynamic body");
   }
-  if (!(factor >= 0 && factor <= 100)) {
+  if (!(factor >= 0 && factor <= kMaxEfficiency)) {
     std::ostringstream out;
-    out << "setBodyEfficiency: factor = " << factor << " must be in [0, 100]";
+    out << "setBodyEfficiency: factor = " << factor << " must be in [0, " << kMaxEfficiency << "]";
     refuse(out.str());
   }
   impl_->bodies[static_cast<std::size_t>(body)].efficiency = factor;

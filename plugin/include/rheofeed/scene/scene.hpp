@@ -97,7 +97,7 @@ const char* toString(DriftModel model);
 bool parseDriftModel(const std::string& name, DriftModel& model);
 
 /// Largest part efficiency factor (dimensionless), as FeederSet::setPartEfficiency accepts.
-constexpr double kMaxPartEfficiency = 100;
+constexpr double kMaxPartEfficiency = kMaxEfficiency;
 
 /// How a feeder moves.
 struct FeederLaw {
