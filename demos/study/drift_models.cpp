@@ -127,7 +127,7 @@ struct ModelResult {
   std::string note;  // why not, or how calibrated
   double drift = 0, ci95 = 0;
   double run_cpu = 0, calibration_cpu = 0;
-  RunHealth health;
+  int parts_lost = 0;  // summed over the seeds (RunHealth::partsLost)
 };
 
 struct SceneResult {
@@ -135,7 +135,7 @@ struct SceneResult {
   Method judge = Method::OdeFullVibration;
   int judge_steps_per_cycle = 0;
   double reference = 0, reference_ci95 = 0, reference_cpu = 0;
-  RunHealth reference_health;
+  int reference_parts_lost = 0;
   ModelResult models[kModelCount];
 };
 
@@ -144,9 +144,9 @@ Scene withDriftModel(Scene s, int fixture, DriftModel model) {
   return s;
 }
 
-std::string lossNote(const RunHealth& h) {
-  if (h.partsLost() == 0) return "";
-  return " (" + std::to_string(h.partsLost()) + " parts lost)";
+std::string lossNote(int parts_lost) {
+  if (parts_lost == 0) return "";
+  return " (" + std::to_string(parts_lost) + " parts lost)";
 }
 
 // Writes drift_models.{csv,md,png} for the scenes done so far (after every scene, so a long
@@ -157,7 +157,7 @@ bool writeOutputs(const DriftModelStudyOptions& o, const std::vector<SceneResult
   // Outputs: CSV (one row per scene and model), markdown table, error bar chart.
   std::ostringstream csv, md, bars;
   csv << "scene,model,drift,ci95,reference,reference_ci95,error,run_cpu_s,calibration_cpu_s,"
-         "reference_cpu_s,parts_lost,note\n";
+         "reference_cpu_s,parts_lost,reference_parts_lost,note\n";
   md << "Drift models against full vibration (the judge: ODE, or the reference engine where "
         "marked, at the steps per cycle given"
      << (o.quick ? ", QUICK run" : "")
@@ -179,9 +179,10 @@ bool writeOutputs(const DriftModelStudyOptions& o, const std::vector<SceneResult
     for (int k = 0; k < kModelCount; ++k) {
       const ModelResult& m = r.models[k];
       const double error = m.ran ? (m.drift - r.reference) / std::abs(r.reference) : NAN;
-      std::snprintf(line, sizeof line, "%s,%s,%.8g,%.4g,%.8g,%.4g,%.6g,%.4g,%.4g,%.4g,%d,\"%s\"\n",
-                    r.name.c_str(), kModels[k], m.drift, m.ci95, r.reference, r.reference_ci95,
-                    error, m.run_cpu, m.calibration_cpu, r.reference_cpu, m.health.partsLost(),
+      std::snprintf(line, sizeof line,
+                    "%s,%s,%.8g,%.4g,%.8g,%.4g,%.6g,%.4g,%.4g,%.4g,%d,%d,\"%s\"\n", r.name.c_str(),
+                    kModels[k], m.drift, m.ci95, r.reference, r.reference_ci95, error, m.run_cpu,
+                    m.calibration_cpu, r.reference_cpu, m.parts_lost, r.reference_parts_lost,
                     m.note.c_str());
       csv << line;
       if (m.ran) {
@@ -292,7 +293,7 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
           entry.reference_judge ? Method::ReferenceFullVibration : Method::OdeFullVibration;
       r.judge = judge;
       auto mean_over_seeds = [&](const Scene& base, Method method, const std::string& label,
-                                 double* ci, double* cpu, RunHealth* health) {
+                                 double* ci, double* cpu, int* parts_lost) {
         double sum = 0;
         for (int k = 0; k < o.seeds; ++k) {
           Scene s = base;
@@ -301,7 +302,7 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
           sum += m.mean_drift;
           *cpu += m.cpu_seconds;
           if (k == 0) *ci = m.mean_drift_ci95;
-          *health = m.health;
+          *parts_lost += m.health.partsLost();
         }
         return sum / o.seeds;
       };
@@ -310,11 +311,11 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
         s.solver.time_step = 1.0 / (f * ref_spc);
         r.reference = mean_over_seeds(
             s, judge, entry.name + " full vibration " + std::to_string(ref_spc) + " steps/cycle",
-            &r.reference_ci95, &r.reference_cpu, &r.reference_health);
+            &r.reference_ci95, &r.reference_cpu, &r.reference_parts_lost);
       }
       std::fprintf(stderr, "%s: full vibration %.6g +- %.2g (%.1f s CPU)%s\n", entry.name.c_str(),
                    r.reference, r.reference_ci95, r.reference_cpu,
-                   lossNote(r.reference_health).c_str());
+                   lossNote(r.reference_parts_lost).c_str());
 
       // The rheonomic runs, one per model.
       auto rheonomic = [&](int k, const Scene& s) {
@@ -323,11 +324,11 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
         run.outputs.sample_interval = std::max(h_rheonomic, scene.outputs.sample_interval);
         ModelResult& m = r.models[k];
         m.drift = mean_over_seeds(run, Method::OdeRheonomic, entry.name + " " + kModels[k], &m.ci95,
-                                  &m.run_cpu, &m.health);
+                                  &m.run_cpu, &m.parts_lost);
         m.ran = true;
         std::fprintf(stderr, "%s: %s %.6g (%+.1f %%)%s\n", entry.name.c_str(), kModels[k], m.drift,
                      100 * (m.drift - r.reference) / std::abs(r.reference),
-                     lossNote(m.health).c_str());
+                     lossNote(m.parts_lost).c_str());
       };
       auto attempt = [&](int k, const std::function<void()>& body) {
         try {
