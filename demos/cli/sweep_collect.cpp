@@ -113,8 +113,8 @@ bool plotLines(const Manifest& m, const std::vector<Row>& rows, std::size_t meth
       "set datafile separator ','\nset datafile missing 'NaN'\nset grid\nset key outside right "
       "top\nset xlabel '" +
       m.parameters[param].name + "'\nset ylabel '" + m.metrics[metric].name + "'\nset title '" +
-      m.name + ": " + m.metrics[metric].name + " (" + m.methods[method] +
-      "), mean over the seeds with its 95 % interval'\nplot " + plot;
+      m.metrics[metric].name + " (" + m.methods[method] +
+      "): mean over the seeds, 95 % interval'\nplot " + plot;
   return scene::plotPng(script, blocks, file.string());
 }
 
@@ -154,13 +154,13 @@ bool plotMap(const Manifest& m, const std::vector<Row>& rows, std::size_t method
   const std::string cells = grid ? "$d using 1:2:3 with image notitle"
                                  : "$d using 1:2:3 with points pt 5 ps 5 lc palette notitle";
   const std::string script =
-      "set datafile separator ','\nset datafile missing 'NaN'\nset xlabel '" +
-      m.parameters[x].name + "'\nset ylabel '" + m.parameters[y].name + "'\nset cblabel '" +
-      m.metrics[metric].name + "'\nset title '" + m.name + ": " + m.metrics[metric].name + " (" +
-      m.methods[method] + "), mean over the seeds; blank: no value'\nset palette rgb 33,13,10\n" +
+      "set datafile separator ','\nset xlabel '" + m.parameters[x].name + "'\nset ylabel '" +
+      m.parameters[y].name + "'\nset cblabel '" + m.metrics[metric].name + "'\nset title '" +
+      m.name + ": " + m.metrics[metric].name + " (" + m.methods[method] +
+      "), mean over the seeds; blank (NaN): no value'\nset palette rgb 33,13,10\n" +
       (grid ? "set autoscale fix\n"
             : "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n") +
-      "plot " + cells + ", $d using 1:2:(sprintf('%.3g', $3)) with labels font ',9' notitle";
+      "plot " + cells + ", $d using 1:2:(sprintf('%.4g', $3)) with labels font ',9' notitle";
   return scene::plotPng(script, {{"d", csv}}, file.string());
 }
 

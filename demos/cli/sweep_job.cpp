@@ -400,7 +400,13 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
                                 " (ids " + jobId(0, count) + " to " + jobId(count - 1, count) +
                                 ")");
   }
-  if (std::optional<Record> r = readRecord(folder, manifest, id); r && r->status == "ok") {
+  std::optional<Record> done;
+  try {
+    done = readRecord(folder, manifest, id);
+  } catch (const std::exception& e) {  // only a hand-edited record: records are written whole
+    std::fprintf(stderr, "rheofeed sweep job: %s; running the job again\n", e.what());
+  }
+  if (done && done->status == "ok") {
     std::printf("job %s: finished before (record %s), not run again\n", id.c_str(),
                 folder.record(id).string().c_str());
     std::fflush(stdout);

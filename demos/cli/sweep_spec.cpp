@@ -391,13 +391,14 @@ Spec loadSpec(const fs::path& file) {
 
   // The base scene: a shipped name, or a file relative to the spec's folder.
   if (!j.contains("scene")) fail(file, "scene", "missing (a shipped scene name or a scene file)");
+  scene::Scene base_scene;
   const std::string scene_arg = r.string(j["scene"], "scene");
   try {
     fs::path s = resolveScene(scene_arg);
     const bool is_path = scene_arg.find('/') != std::string::npos || s.extension() == ".json";
     if (is_path && s.is_relative()) s = file.parent_path() / s;  // relative to the spec
     spec.scene_file = fs::absolute(s).lexically_normal();
-    scene::loadScene(spec.scene_file);  // the base scene itself is valid
+    base_scene = scene::loadScene(spec.scene_file);  // the base scene itself is valid
   } catch (const std::exception& e) {
     fail(file, "scene", e.what());
   }
@@ -570,7 +571,6 @@ Spec loadSpec(const fs::path& file) {
          "must be a non-empty list of {name, pointer} (pointers into a run's JSON, e.g. "
          "\"/mean_drift\")");
   }
-  const scene::Scene base_scene = scene::loadScene(spec.scene_file);
   const Json skeleton = runJsonSkeleton(base_scene, spec.methods[0]);
   std::set<std::string> metric_names;
   for (std::size_t k = 0; k < j["metrics"].size(); ++k) {

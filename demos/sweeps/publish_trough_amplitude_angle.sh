@@ -10,6 +10,7 @@
 # RHEOFEED defaults to build/bin/rheofeed, WORK_DIR to a new temporary folder (kept: the three
 # sweep folders). Takes about 6 + 2 x 3 minutes on a 2-core machine.
 set -euo pipefail
+shopt -s inherit_errexit  # a failed sweep inside $(run ...) stops the script
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 bin="${1:-$root/build/bin/rheofeed}"
 work="${2:-$(mktemp -d)}"
