@@ -9,10 +9,12 @@
 #include <string>
 #include <vector>
 
-#include "cli/calibrate_scene.hpp"
+#include "rheofeed/measure/calibration.hpp"
 #include "cli/run_plan.hpp"
 
 namespace rheofeed::cli {
+
+using rheofeed::scene::CalibrateOptions;
 
 /// `rheofeed run SCENE`: runs every method, writes <method>.csv/.json/.png, methods.png,
 /// mean_height.png and, with `animation`, <first method>.glb and view.html into `out`. Prints a

@@ -158,9 +158,9 @@ int main(int argc, char** argv) {
   sweep_cmd->add_option("SPEC", sweep.spec, "the sweep spec (.json)");
   sweep_cmd->add_option("--backend", sweep.backend, "local, parallel or slurm")
       ->capture_default_str();
-  sweep_cmd->add_option("--jobs", sweep.jobs, "jobs at a time (local, parallel), >= 1")
+  sweep_cmd->add_option("--jobs", sweep.jobs, "jobs at a time (local, parallel), 1 to 1024")
       ->default_str("the available cores")
-      ->check(CLI::Range(1, 4096));
+      ->check(CLI::Range(1, 1024));
   sweep_cmd
       ->add_option("--out", sweep.out,
                    "the sweep folder (a folder of an earlier run of "

@@ -16,7 +16,7 @@
 #include <system_error>
 
 #include "cli/sweep.hpp"
-#include "rheofeed/scene/output.hpp"
+#include "rheofeed/output/output.hpp"
 
 namespace rheofeed::cli::sweep {
 

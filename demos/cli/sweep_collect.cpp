@@ -9,9 +9,9 @@
 #include <system_error>
 
 #include "cli/sweep.hpp"
-#include "rheofeed/scene/metrics.hpp"
-#include "rheofeed/scene/output.hpp"
-#include "rheofeed/scene/plot.hpp"
+#include "rheofeed/measure/statistics.hpp"
+#include "rheofeed/output/output.hpp"
+#include "rheofeed/output/plot.hpp"
 
 namespace rheofeed::cli::sweep {
 

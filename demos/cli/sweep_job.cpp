@@ -24,7 +24,7 @@
 #include <system_error>
 
 #include "cli/sweep.hpp"
-#include "rheofeed/scene/output.hpp"
+#include "rheofeed/output/output.hpp"
 
 extern char** environ;
 

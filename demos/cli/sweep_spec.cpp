@@ -18,7 +18,8 @@
 #include "cli/run_plan.hpp"
 #include "cli/shipped_scenes.hpp"
 #include "cli/sweep.hpp"
-#include "rheofeed/scene/metrics.hpp"
+#include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/output/output.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 
 namespace rheofeed::cli::sweep {

@@ -11,13 +11,8 @@
 #   bash sweep_backend_test.sh RHEOFEED SPEC WORK_DIR BACKEND [REFERENCE_CSV]
 set -euo pipefail
 bin=$1 spec=$2 work=$3 backend=$4 reference=${5:-}
-fail() {
-  echo "FAIL: $*" >&2
-  for f in "$work"/*.log; do [ -f "$f" ] && { echo "--- $f" >&2; cat "$f" >&2; }; done
-  exit 1
-}
-rm -rf "$work"
-mkdir -p "$work"
+# shellcheck source=test_lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/test_lib.sh"
 jobs_total=4
 
 # 1. The whole sweep.

@@ -7,13 +7,8 @@
 #   bash sweep_failed_job_test.sh RHEOFEED SPEC WORK_DIR
 set -euo pipefail
 bin=$1 spec=$2 work=$3
-fail() {
-  echo "FAIL: $*" >&2
-  for f in "$work"/*.log; do [ -f "$f" ] && { echo "--- $f" >&2; cat "$f" >&2; }; done
-  exit 1
-}
-rm -rf "$work"
-mkdir -p "$work"
+# shellcheck source=test_lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/test_lib.sh"
 dir="$work/sweep"
 # The folder written, nothing run (the Slurm scripts are only written).
 "$bin" sweep "$spec" --backend slurm --out "$dir" > "$work/prepare.log" 2>&1 || fail "prepare: $?"
