@@ -536,4 +536,11 @@ bool StepLaw::sameMotionAs(const StepLaw& other) const {
   }
 }
 
+Vec3 contactSurfaceVelocity(const StepLaw& law, const Vec3& p, const Vec3& n, const Vec3& n_out,
+                            double mu, double efficiency, const Vec3* carried) {
+  if (law.needsContactSide()) return law.contactVelocity(p, n_out, mu, efficiency, carried);
+  if (carried && law.usesCarriedPoint()) return law.tangentialVelocity(p, n, *carried);
+  return law.tangentialVelocity(p, n);
+}
+
 }  // namespace rheofeed

@@ -280,15 +280,10 @@ struct World::Impl {
     auto it = feeder_index.find(g);
     if (it == feeder_index.end()) return Vector3d::Zero();
     const StepLaw& law = feeders[it->second].frozen;
-    if (law.needsContactSide()) {
-      if (carried == kStatic) return toEigen(law.contactVelocity(toVec3(p), toVec3(n_out), mu));
-      const Body& body = bodies[static_cast<std::size_t>(carried)];
-      return toEigen(
-          law.contactVelocity(toVec3(p), toVec3(n_out), mu, body.efficiency, &body.state.position));
-    }
-    if (carried == kStatic) return toEigen(law.tangentialVelocity(toVec3(p), toVec3(n_out)));
-    return toEigen(
-        law.tangentialVelocity(toVec3(p), toVec3(n_out), bodies[carried].state.position));
+    const Body* body = carried == kStatic ? nullptr : &bodies[static_cast<std::size_t>(carried)];
+    return toEigen(contactSurfaceVelocity(law, toVec3(p), toVec3(n_out), toVec3(n_out), mu,
+                                          body ? body->efficiency : 1.0,
+                                          body ? &body->state.position : nullptr));
   }
 
   void freezeLaws(double h) {
