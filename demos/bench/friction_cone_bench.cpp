@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/box_pile.hpp"
 #include "rheofeed/feeder_set.hpp"
 
 namespace {
@@ -30,7 +31,6 @@ using rheofeed::FeederSet;
 using rheofeed::FrictionModel;
 using rheofeed::MotionLaw;
 
-constexpr int kMaxContacts = 8;
 constexpr double kStep = 0.005;    // s
 constexpr int kSweeps = 20;        // quickstep iterations
 constexpr int kSettleSteps = 100;  // untimed steps before timing: the pile is in contact
@@ -38,73 +38,24 @@ constexpr int kTimedSteps = 200;   // steps per repetition
 constexpr int kRepetitions = 15;
 int g_boxes = 400;
 
+// The pile with the ground as a belt feeder, every contact with friction model `model`.
 struct Pile {
-  dWorldID world;
-  dSpaceID space;
-  dJointGroupID group;
-  dGeomID ground;
-  std::unique_ptr<FeederSet> feeders;
-  FrictionModel model;
-  int mode;
-  long joints = 0;  // contact joints created in the timed steps
+  rheofeed::demo::BoxPile pile;
+  FeederSet feeders;
 
-  explicit Pile(FrictionModel m) : model(m), mode(withFrictionModel(dContactApprox1, m)) {
-    world = dWorldCreate();
-    dWorldSetGravity(world, 0, 0, -9.81);
-    dWorldSetQuickStepNumIterations(world, kSweeps);
-    space = dHashSpaceCreate(nullptr);
-    group = dJointGroupCreate(0);
-    ground = dCreateBox(space, 10, 10, 0.2);
-    dGeomSetPosition(ground, 0, 0, -0.1);
-    const int side = 10;
-    for (int i = 0; i < g_boxes; ++i) {
-      const int layer = i / (side * side), k = i % (side * side);
-      dBodyID b = dBodyCreate(world);
-      dMass mass;
-      dMassSetBoxTotal(&mass, 0.1, 0.1, 0.1, 0.1);
-      dBodySetMass(b, &mass);
-      dBodySetPosition(b, (k % side) * 0.12 + 0.01 * (layer % 2), (k / side) * 0.12,
-                       0.06 + layer * 0.11);
-      dGeomSetBody(dCreateBox(space, 0.1, 0.1, 0.1), b);
-    }
-    FeederSet::Options options;
-    options.friction = m;
-    feeders = std::make_unique<FeederSet>(options);
-    feeders->add(ground, MotionLaw::belt({1, 0, 0}, 0.2));
+  explicit Pile(FrictionModel model)
+      : pile(g_boxes, withFrictionModel(dContactApprox1, model), kSweeps), feeders(options(model)) {
+    feeders.add(pile.ground(), MotionLaw::belt({1, 0, 0}, 0.2));
+    pile.setFeeders(&feeders);
     for (int i = 0; i < kSettleSteps; ++i) step();
-    joints = 0;
+    pile.resetJointCount();
   }
-  ~Pile() {
-    dJointGroupDestroy(group);
-    dSpaceDestroy(space);
-    dWorldDestroy(world);
+  static FeederSet::Options options(FrictionModel model) {
+    FeederSet::Options o;
+    o.friction = model;
+    return o;
   }
-
-  static void nearCallback(void* data, dGeomID o1, dGeomID o2) {
-    auto* self = static_cast<Pile*>(data);
-    dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
-    dContact contact[kMaxContacts];
-    int n = dCollide(o1, o2, kMaxContacts, &contact[0].geom, sizeof(dContact));
-    for (int i = 0; i < n; ++i) {
-      contact[i].surface.mode = self->mode;
-      contact[i].surface.mu = 0.5;
-    }
-    n = self->feeders->driveContacts(contact, n);
-    for (int i = 0; i < n; ++i) {
-      dJointID c = dJointCreateContact(self->world, self->group, contact + i);
-      dJointAttach(c, b1, b2);
-    }
-    self->joints += n;
-  }
-
-  double time = 0;
-  void step() {
-    feeders->beginStep(time, kStep);
-    dSpaceCollide(space, this, &nearCallback);
-    dWorldQuickStep(world, kStep);
-    dJointGroupEmpty(group);
-    time += kStep;
-  }
+  void step() { pile.step(kStep, kStep); }
 };
 
 std::map<int, double> g_joints_per_step;  // by model, from the last repetition
@@ -114,8 +65,9 @@ void BM_PileStep(benchmark::State& state) {
   Pile pile(model);
   for (auto _ : state) pile.step();
   state.counters["bodies"] = g_boxes;
-  state.counters["joints_per_step"] = static_cast<double>(pile.joints) / kTimedSteps;
-  g_joints_per_step[static_cast<int>(model)] = static_cast<double>(pile.joints) / kTimedSteps;
+  state.counters["joints_per_step"] = static_cast<double>(pile.pile.jointCount()) / kTimedSteps;
+  g_joints_per_step[static_cast<int>(model)] =
+      static_cast<double>(pile.pile.jointCount()) / kTimedSteps;
 }
 BENCHMARK(BM_PileStep)
     ->ArgName("cone")
@@ -146,8 +98,7 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--boxes") == 0) {
       g_boxes = std::atoi(argv[i + 1]);
       if (g_boxes < 1 || g_boxes > 100000) {
-        std::fprintf(stderr, "friction_cone_bench: --boxes %s must be in 1..100000\n",
-                     argv[i + 1]);
+        std::fprintf(stderr, "friction_cone_bench: --boxes %s must be in 1..100000\n", argv[i + 1]);
         return 2;
       }
       for (int k = i; k + 2 < argc + 1; ++k) argv[k] = argv[k + 2];
@@ -175,9 +126,10 @@ int main(int argc, char** argv) {
   };
   const double pyramid = get("BM_PileStep/cone:0");
   const double cone = get("BM_PileStep/cone:1");
-  std::printf("\n## Friction cone cost (medians of %d repetitions x %d steps, %d boxes, %d "
-              "sweeps)\n\n",
-              kRepetitions, kTimedSteps, g_boxes, kSweeps);
+  std::printf(
+      "\n## Friction cone cost (medians of %d repetitions x %d steps, %d boxes, %d "
+      "sweeps)\n\n",
+      kRepetitions, kTimedSteps, g_boxes, kSweeps);
   std::printf("| quantity | value |\n|---|---|\n");
   if (pyramid > 0) std::printf("| pile step, pyramid (us) | %.1f |\n", pyramid);
   if (cone > 0) std::printf("| pile step, cone (us) | %.1f |\n", cone);

@@ -122,8 +122,7 @@ void rfFeederSetDestroy(rfFeederSetID set) {
 int rfFeederSetSetFrictionModel(rfFeederSetID set, int model) {
   return guarded(set, [&] {
     if (model != rfFrictionPyramid && model != rfFrictionCone) {
-      throw std::invalid_argument("rfFeederSetSetFrictionModel: model = " +
-                                  std::to_string(model) +
+      throw std::invalid_argument("rfFeederSetSetFrictionModel: model = " + std::to_string(model) +
                                   " must be rfFrictionPyramid (0) or rfFrictionCone (1)");
     }
     set->set.setFrictionModel(model == rfFrictionCone ? rheofeed::FrictionModel::Cone

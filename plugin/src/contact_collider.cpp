@@ -19,8 +19,8 @@ ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders, const Setti
                                 " must be in 1..65535");
   }
   requireFrictionModel(settings.friction, "rheofeed::ContactCollider: Settings::friction");
-  settings_.default_surface.mode = withFrictionModel(settings.default_surface.mode,
-                                                     settings.friction);
+  settings_.default_surface.mode =
+      withFrictionModel(settings.default_surface.mode, settings.friction);
   buffer_.resize(static_cast<std::size_t>(settings.max_contacts_per_pair));
   group_ = dJointGroupCreate(0);
 }

@@ -235,8 +235,8 @@ struct FeederSet::Impl {
   void lookup(const dContact& c, PairCache& pair) const;
   Sides sides(const dContact& c, const PairCache& pair) const;
   Velocities surfaceVelocities(const dContact& c, const PairCache& pair, const Sides& sd);
-  bool feederVelocity(Feeder& f, const dContact& c, bool feeder_is_g1, dBodyID other,
-                      const Vec3& p, const Vec3& n, Vec3& value);
+  bool feederVelocity(Feeder& f, const dContact& c, bool feeder_is_g1, dBodyID other, const Vec3& p,
+                      const Vec3& n, Vec3& value);
   bool write(dContact& c, Feeder& primary, const Velocities& v);
   void record(const dContact& c, const PairCache& pair, const Sides& sd, const Velocities& v,
               bool driven) noexcept;
@@ -346,8 +346,8 @@ FeederSet::Impl::Velocities FeederSet::Impl::surfaceVelocities(const dContact& c
 // One feeder's law at the contact into `value`; false (reported, counted) when the law failed
 // or threw. `feeder_is_g1`: the normal n (ODE's, from g2 into g1) points out of the feeder
 // when it is g2. `other`: the body on the other side of the contact (0 if static).
-bool FeederSet::Impl::feederVelocity(Feeder& f, const dContact& c, bool feeder_is_g1,
-                                     dBodyID other, const Vec3& p, const Vec3& n, Vec3& value) {
+bool FeederSet::Impl::feederVelocity(Feeder& f, const dContact& c, bool feeder_is_g1, dBodyID other,
+                                     const Vec3& p, const Vec3& n, Vec3& value) {
   // User functions (field, twist function, profile) run in here: whatever they throw is caught,
   // and the contact is left undriven (no exception may unwind into ODE).
   try {
@@ -386,8 +386,8 @@ bool FeederSet::Impl::feederVelocity(Feeder& f, const dContact& c, bool feeder_i
     ++f.stats.law_threw;
     report(f, DiagnosticKind::LawThrew, [&] {
       std::ostringstream out;
-      out << "law threw at p = (" << p.x << ", " << p.y << ", " << p.z << "), t = " << time
-          << ": " << detail::currentExceptionMessage() << "; contact left undriven";
+      out << "law threw at p = (" << p.x << ", " << p.y << ", " << p.z << "), t = " << time << ": "
+          << detail::currentExceptionMessage() << "; contact left undriven";
       return out.str();
     });
     return false;
@@ -441,8 +441,8 @@ bool FeederSet::Impl::write(dContact& c, Feeder& primary, const Velocities& v) {
 void FeederSet::Impl::record(const dContact& c, const PairCache& pair, const Sides& sd,
                              const Velocities& v, bool driven) noexcept {
   Feeder& primary = pair.f1 ? *pair.f1 : *pair.f2;
-  int FeederStats::*counter = driven ? &FeederStats::contacts_driven
-                                     : &FeederStats::contacts_undriven;
+  int FeederStats::*counter =
+      driven ? &FeederStats::contacts_driven : &FeederStats::contacts_undriven;
   ++(primary.stats.*counter);
   if (pair.f1 && pair.f2) ++(pair.f2->stats.*counter);
   if (!options.record_contacts) return;

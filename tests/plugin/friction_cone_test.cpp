@@ -30,9 +30,9 @@ namespace {
 constexpr bool kBuiltWithCone = RHEOFEED_TEST_ODE_HAS_CONE != 0;
 constexpr double kStep = 0.001;  // s
 constexpr double kMu = 0.4;
-constexpr double kMass = 1.0;    // kg
-constexpr double kEdge = 0.1;    // m, cube
-constexpr double kLayer = 1e-4;  // m, contact surface layer (parts start in resting contact)
+constexpr double kMass = 1.0;     // kg
+constexpr double kEdge = 0.1;     // m, cube
+constexpr double kLayer = 1e-4;   // m, contact surface layer (parts start in resting contact)
 constexpr int kIterations = 100;  // quickstep sweeps: converged for one box on four contacts
 // The diagonal of ODE's friction axes: for the normal +z, dPlaneSpace gives t1 = -y, t2 = +x.
 constexpr double kDiagonal = kPi / 4;
@@ -46,10 +46,10 @@ constexpr double kStuck = 1e-5;
 // Straight line: the velocity turns by less than this (rad) while a slide decays.
 constexpr double kStraight = 1e-3;
 
-#define RHEOFEED_REQUIRE_CONE()                                                              \
-  if (!kBuiltWithCone) {                                                                     \
+#define RHEOFEED_REQUIRE_CONE()                                                             \
+  if (!kBuiltWithCone) {                                                                    \
     GTEST_SKIP() << "linked with a stock ODE (RHEOFEED_ODE=system): no friction cone; the " \
-                    "refusal is FrictionCone.StockOdeRefusesTheConeNamingTheSetting";        \
+                    "refusal is FrictionCone.StockOdeRefusesTheConeNamingTheSetting";       \
   }
 
 /// A static floor (top at z = 0) and a cube resting on it, stepped with dWorldQuickStep; every
