@@ -37,10 +37,6 @@ std::string geomName(dGeomID geom) {
 
 }  // namespace
 
-const char* toString(FrictionModel model) {
-  return model == FrictionModel::Cone ? "cone" : "pyramid";
-}
-
 bool odeHasFrictionCone() {
   static const bool has_cone = dCheckConfiguration("ODE_EXT_friction_cone") != 0;
   return has_cone;

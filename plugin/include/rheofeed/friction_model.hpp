@@ -23,7 +23,23 @@ enum class FrictionModel {
   Cone,     ///< the two rows limited together to the disc of radius mu N (patched ODE only)
 };
 /// Printable name: "pyramid" or "cone".
-const char* toString(FrictionModel model);
+inline const char* toString(FrictionModel model) {
+  return model == FrictionModel::Cone ? "cone" : "pyramid";
+}
+/// The model named `name` ("cone" or "pyramid"); false for any other name.
+inline bool parseFrictionModel(const char* name, FrictionModel& model) {
+  const char* names[] = {"pyramid", "cone"};
+  for (int k = 0; k < 2; ++k) {
+    const char* a = name;
+    const char* b = names[k];
+    while (*a && *a == *b) ++a, ++b;
+    if (*a == *b) {
+      model = k == 1 ? FrictionModel::Cone : FrictionModel::Pyramid;
+      return true;
+    }
+  }
+  return false;
+}
 
 /// ODE's surface mode bit for the cone (dContactFrictionCone of the patched contact.h). It is
 /// defined here too so that rheofeed compiles against stock headers; a stock library ignores it.
