@@ -606,6 +606,7 @@ Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h) {
   }
   const double rate = angle / h;
   return {axis.x * rate, axis.y * rate, axis.z * rate};
+}
 
 Vec3 contactSurfaceVelocity(const StepLaw& law, const Vec3& p, const Vec3& n, const Vec3& n_out,
                             double mu, double efficiency, const Vec3* carried) {
