@@ -608,4 +608,11 @@ Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h) {
   return {axis.x * rate, axis.y * rate, axis.z * rate};
 }
 
+Vec3 contactSurfaceVelocity(const StepLaw& law, const Vec3& p, const Vec3& n, const Vec3& n_out,
+                            double mu, double efficiency, const Vec3* carried) {
+  if (law.needsContactSide()) return law.contactVelocity(p, n_out, mu, efficiency, carried);
+  if (carried && law.usesCarriedPoint()) return law.tangentialVelocity(p, n, *carried);
+  return law.tangentialVelocity(p, n);
+}
+
 }  // namespace rheofeed

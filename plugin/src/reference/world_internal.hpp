@@ -241,17 +241,11 @@ struct WorldState {
     auto it = feeder_index.find(g);
     if (it == feeder_index.end()) return Vector3d::Zero();
     const StepLaw& law = feeders[it->second].frozen;
-    if (law.needsContactSide()) {
-      if (carried == kStatic)
-        return detail::toEigen(law.contactVelocity(detail::toVec3(p), detail::toVec3(n_out), mu));
-      const Body& body = bodies[static_cast<std::size_t>(carried)];
-      return detail::toEigen(law.contactVelocity(detail::toVec3(p), detail::toVec3(n_out), mu,
-                                                 body.efficiency, &body.state.position));
-    }
-    if (carried == kStatic)
-      return detail::toEigen(law.tangentialVelocity(detail::toVec3(p), detail::toVec3(n_out)));
-    return detail::toEigen(law.tangentialVelocity(detail::toVec3(p), detail::toVec3(n_out),
-                                                  bodies[carried].state.position));
+    const Body* body = carried == kStatic ? nullptr : &bodies[static_cast<std::size_t>(carried)];
+    return detail::toEigen(contactSurfaceVelocity(law, detail::toVec3(p), detail::toVec3(n_out),
+                                                  detail::toVec3(n_out), mu,
+                                                  body ? body->efficiency : 1.0,
+                                                  body ? &body->state.position : nullptr));
   }
 
   void freezeLaws(double h) {

@@ -285,6 +285,11 @@ void Scene::validate() const {
         "must be in [1, " + std::to_string(limits::kMaxIterations) + "]");
   }
   if (!(solver.erp >= 0 && solver.erp <= 1)) bad("solver.erp", solver.erp, "must be in [0, 1]");
+  if (solver.friction == FrictionModel::Cone && !solver.ode_quickstep) {
+    throw std::invalid_argument(
+        "solver.friction = \"cone\" needs solver.ode_quickstep = true: dWorldStep (the Dantzig "
+        "LCP) cannot express a friction cone; use \"pyramid\" or quickstep");
+  }
   nonNegative("solver.cfm", solver.cfm);
   positive("solver.max_correcting_velocity", solver.max_correcting_velocity);
   within("solver.max_correcting_velocity", solver.max_correcting_velocity, 0, limits::kMaxSpeed,

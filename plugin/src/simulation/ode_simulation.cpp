@@ -36,7 +36,11 @@ class OdeSimulation final : public PartSimulation {
     dWorldSetContactMaxCorrectingVel(world_, scene.solver.max_correcting_velocity);
     dWorldSetContactSurfaceLayer(world_, scene.solver.surface_layer);
     space_ = dHashSpaceCreate(nullptr);
-    feeders_ = std::make_unique<FeederSet>();
+    const FrictionModel friction = odeFrictionModel(scene.solver);
+    health_.friction_model = toString(friction);
+    FeederSet::Options options;
+    options.friction = friction;
+    feeders_ = std::make_unique<FeederSet>(options);
 
     for (std::size_t fi = 0; fi < scene.fixtures.size(); ++fi) {
       const Fixture& f = scene.fixtures[fi];
@@ -68,11 +72,14 @@ class OdeSimulation final : public PartSimulation {
 
     ContactCollider::Settings cs;
     cs.feedback = true;
+    cs.friction = friction;
     collider_ = std::make_unique<ContactCollider>(world_, *feeders_, cs);
     const double mu = scene.material.mu, bounce = scene.material.restitution;
-    collider_->setSurfaceCallback([mu, bounce](dGeomID, dGeomID, dContact* c, int n) {
+    const int mode =
+        withFrictionModel(dContactApprox1 | (bounce > 0 ? dContactBounce : 0), friction);
+    collider_->setSurfaceCallback([mu, bounce, mode](dGeomID, dGeomID, dContact* c, int n) {
       for (int i = 0; i < n; ++i) {
-        c[i].surface.mode = dContactApprox1 | (bounce > 0 ? dContactBounce : 0);
+        c[i].surface.mode = mode;
         c[i].surface.mu = mu;
         c[i].surface.bounce = bounce;
         c[i].surface.bounce_vel = 0;

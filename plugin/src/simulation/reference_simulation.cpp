@@ -151,6 +151,11 @@ class ReferenceSimulation final : public PartSimulation {
   // Settings of the scene the reference world does not read, when they differ from their
   // defaults.
   void listIgnoredSettings() {
+    health_.friction_model = "cone";
+    if (scene_.solver.friction == FrictionModel::Pyramid) {
+      ignoreSetting(
+          "solver.friction = pyramid: ignored by the reference solver (it solves the cone)");
+    }
     if (!scene_.solver.ode_quickstep) {
       ignoreSetting(
           "solver.ode_quickstep = false: ignored by the reference solver (ODE's stepper choice)");

@@ -572,6 +572,22 @@ double PartSimulation::partMass(int index) const {
   return instances_.at(static_cast<std::size_t>(index)).mass;
 }
 
+FrictionModel odeFrictionModel(const SolverSettings& solver) {
+  if (!solver.friction) {
+    return solver.ode_quickstep && odeHasFrictionCone() ? FrictionModel::Cone
+                                                        : FrictionModel::Pyramid;
+  }
+  if (*solver.friction == FrictionModel::Cone) {
+    if (!solver.ode_quickstep) {
+      throw std::invalid_argument(
+          "solver.friction = \"cone\" needs solver.ode_quickstep = true: dWorldStep (the "
+          "Dantzig LCP) cannot express a friction cone");
+    }
+    requireFrictionModel(FrictionModel::Cone, "solver.friction");
+  }
+  return *solver.friction;
+}
+
 std::unique_ptr<Simulation> makeSimulation(const Scene& scene, Method method) {
   scene.validate();
   if (method == Method::OdeRheonomic || method == Method::OdeFullVibration) {
