@@ -50,6 +50,22 @@ std::string show(double v) {
 
 // ---- Text to DOM -------------------------------------------------------------------------------
 
+// At most this many characters of what the lexer read are quoted in a syntax error: a line's
+// worth (a token can be the whole file: an unterminated string of 444 KB was quoted in full).
+constexpr std::size_t kMaxQuoted = 60;
+
+// nlohmann's "...; last read: '<token>'" with the token cut to its last kMaxQuoted characters
+// (where the error is), marked "...".
+std::string shortenLastRead(const std::string& problem) {
+  const std::string mark = "last read: '";
+  const std::size_t start = problem.find(mark);
+  if (start == std::string::npos) return problem;
+  const std::size_t begin = start + mark.size();
+  const std::size_t end = problem.rfind('\'');
+  if (end == std::string::npos || end <= begin || end - begin <= kMaxQuoted) return problem;
+  return problem.substr(0, begin) + "..." + problem.substr(end - kMaxQuoted);
+}
+
 // Builds the DOM like nlohmann's own parser, and besides knows the JSON path of the value being
 // read, so that a duplicate key or a number that overflows a double (1e999) is reported with it.
 class DomBuilder final : public nlohmann::json_sax<json> {
@@ -90,6 +106,7 @@ class DomBuilder final : public nlohmann::json_sax<json> {
       const std::size_t colon = what.find(": ", column == std::string::npos ? 0 : column);
       if (colon != std::string::npos) what.erase(0, colon + 2);
       problem_ = what.rfind("syntax error", 0) == 0 ? "JSON " + what : "JSON syntax error: " + what;
+      problem_ = shortenLastRead(problem_);
     }
     return false;
   }
@@ -297,6 +314,15 @@ void read(const json& v, const std::string& path, Distribution& out);
 void read(const json& v, const std::string& path, Twist& out);
 void read(const json& v, const std::string& path, Pose& out);
 
+// |angle| within the scene files' range (scene_limits.hpp, kMaxAngleDegrees).
+void checkAngle(const std::string& path, double angle, double max, const char* unit) {
+  if (!(std::abs(angle) <= max)) {
+    fail(path, "must be in [-" + show(max) + ", " + show(max) + "] " + unit +
+                   " (1e6 degrees: a double resolves no finer angle there than 1e-10 degree), "
+                   "got " + show(angle));
+  }
+}
+
 // A JSON object being read: every key asked for is remembered, and finish() refuses the rest.
 class Object {
  public:
@@ -343,9 +369,11 @@ class Object {
     if (d && r) fail(at(deg), "give either " + deg + " or " + rad + ", not both");
     if (d) {
       read(*d, at(deg), out_rad, range);
+      checkAngle(at(deg), out_rad, limits::kMaxAngleDegrees, "degrees");
       out_rad *= kPi / 180;
     } else if (r) {
       read(*r, at(rad), out_rad, range);
+      checkAngle(at(rad), out_rad, limits::kMaxAngle, "rad");
     }
     return d || r;
   }
