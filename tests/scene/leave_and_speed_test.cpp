@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "common/builtin_scenes.hpp"
 #include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
@@ -137,7 +138,7 @@ TEST(LeftTheFeeder, CubesRunningOffTheBeltsEndWithoutAnExitAreCounted) {
 }
 
 // The turntable: a disc of radius 0.4 m (top z = 0) turning at 50 rad/s about z, a
-// static rim of 16 boxes 4 cm tall at r = 0.41 m, a catch floor 0.3 m below. 20 cubes of 2 cm
+// static rim of 16 boxes 2 cm thick and 4 cm tall closing at r = 0.41 m, a catch floor 0.3 m below. 20 cubes of 2 cm
 // dropped at r = 0.1-0.3 m: their surface speed is 5-15 m/s, far beyond what a 4 cm rim holds
 // back. Independent count: cubes whose centre is beyond the rim (r > 0.42 m) or below the disc.
 Scene fastTurntableScene() {
@@ -154,19 +155,7 @@ Scene fastTurntableScene() {
   disc.law.kind = FeederLaw::Kind::Drift;
   disc.law.drift.angular = {0, 0, 50};
   s.fixtures.push_back(disc);
-  Fixture rim;
-  rim.name = "rim";
-  const double kPi = std::acos(-1.0);
-  for (int k = 0; k < 16; ++k) {
-    const double a = 2 * kPi * k / 16;
-    Fixture::Geom w;
-    w.shape.kind = Shape::Kind::Box;
-    w.shape.size = {0.02, 0.17, 0.04};
-    w.pose = Pose::axisAngle({0, 0, 1}, a);
-    w.pose.position = {0.42 * std::cos(a), 0.42 * std::sin(a), 0.02};
-    rim.geoms.push_back(w);
-  }
-  s.fixtures.push_back(rim);
+  s.fixtures.push_back(boxRing("rim", 16, 0.42, 0.41, 0.02, 0.04, 0.02));
   s.fixtures.push_back(boxFixture("catch_floor", {3, 3, 0.02}, {0, 0, -0.31}));
   s.parts.push_back(cubes(0.02, 20, {0.1, -0.15, 0.02}, {0.3, 0.15, 0.12}));
   s.material.mu = 0.5;
@@ -269,11 +258,6 @@ TEST(PhysicalSpeed, EnergySpeedOfASpinningCubeIsOmegaEdgeOverRootSix) {
 
 // Independent count of parts above their bound: the bound from the case's numbers here, the
 // speed from the states after every step.
-struct SpeedWatch {
-  std::vector<double> spawn_z;
-  std::vector<bool> over;
-};
-
 int partsOverTheirBound(const Scene& s, Method m, double seconds, RunHealth* health) {
   std::unique_ptr<Simulation> sim = makeSimulation(s, m);
   const SceneLimits limits = sceneLimits(s);
