@@ -4,7 +4,8 @@
 // One ray per triangle, from its centroid inwards; the nearest other triangle it meets is the
 // far side of the wall. The triangles are sorted into a bounding-volume tree (axis-aligned
 // boxes, split at the median centroid along the longest axis, at most kLeafSize triangles per
-// leaf), and a ray visits only the boxes it enters before its nearest hit so far. Each
+// leaf), and a ray visits only the boxes it enters before its nearest hit so far, the nearer
+// child of a node first. Each
 // ray/triangle test is the Moller-Trumbore test of the all-pairs version, with the same
 // arithmetic, and the nearest hit is a minimum, which does not depend on the order of the
 // tests: the result is the all-pairs one exactly. The boxes are grown by a relative 1e-9 of
@@ -26,6 +27,7 @@ constexpr int kLeafSize = 4;
 struct Node {
   double lo[3], hi[3];
   int left = -1, right = -1;  // children (inner node), or -1
+  int axis = 0;               // split axis: left holds the lower centroids along it
   int begin = 0, end = 0;     // triangle range in the order (leaf)
 };
 
@@ -65,8 +67,10 @@ class TriangleTree {
         }
         continue;
       }
-      stack[top++] = n.left;
-      stack[top++] = n.right;
+      // Nearer child last (popped first): its hits shrink `best` before the farther is tried.
+      const bool left_first = dir[n.axis] >= 0;
+      stack[top++] = left_first ? n.right : n.left;
+      stack[top++] = left_first ? n.left : n.right;
     }
     return best;
   }
@@ -145,6 +149,7 @@ class TriangleTree {
       };
       std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
                        [&](std::size_t x, std::size_t y) { return key(x) < key(y); });
+      n.axis = axis;
       n.left = build(begin, mid);
       n.right = build(mid, end);
     }
