@@ -90,7 +90,7 @@ void checkTunnelling(const CheckContext& c, std::vector<Hazard>& out) {
                (fixture_thinner ? ", " + c.thin_geom : "");
     std::ostringstream m;
     m << "a part at the expected speed " << fmt(speed) << " m/s (" << source
-      << ") moves c.h (v + c.g c.h) = " << mm(travel) << " per step of " << fmt(c.h)
+      << ") moves h (v + g h) = " << mm(travel) << " per step of " << fmt(c.h)
       << " s, more than half the summed thickness of the thinnest "
       << (fixture_thinner
               ? "fixture geom " + c.thin_geom + " (" + mm(c.thinnest_fixture) + ")" + c.fixture_note
@@ -171,11 +171,11 @@ void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out) {
                  ".size, density, solver.iterations, solver.time_step";
       const double x = c.light_thickness / (c.g * c.h * c.h);
       std::ostringstream m;
-      m << "the c.heaviest part (" << idx("parts", c.heavy_family) << ", " << fmt(c.heaviest)
-        << " kg) is " << fmt(ratio) << " times the c.lightest (" << idx("parts", c.light_family) << ", "
+      m << "the heaviest part (" << idx("parts", c.heavy_family) << ", " << fmt(c.heaviest)
+        << " kg) is " << fmt(ratio) << " times the lightest (" << idx("parts", c.light_family) << ", "
         << fmt(c.lightest) << " kg, " << mm(c.light_thickness) << " thick); "
         << (quickstep ? "ODE quickstep" : "the reference solver") << " with " << k
-        << " iterations at c.h = " << fmt(c.h) << " s (thickness / (c.g c.h^2) = " << fmt(x)
+        << " iterations at h = " << fmt(c.h) << " s (thickness / (g h^2) = " << fmt(x)
         << (limit < 1 ? ") is below the measured range, where even stacks of equal parts sank "
                         "into the floor"
                       : ") was measured to hold a ratio of " + fmt(limit))
@@ -218,9 +218,9 @@ void checkCoarseVibrationStep(const CheckContext& c, std::vector<Hazard>& out) {
       hz.value = per_cycle;
       hz.limit = kMinStepsPerCycle;
       hz.where = "solver.time_step, " + idx("fixtures", f) + ".law.vibration.frequency";
-      hz.message = "a c.full-vibration run resolves the " + fmt(law.vibration.frequency) +
+      hz.message = "a full-vibration run resolves the " + fmt(law.vibration.frequency) +
                    " Hz vibration of fixture '" + c.scene.fixtures[f].name + "' with only " +
-                   fmt(per_cycle) + " steps per cycle (c.h = " + fmt(c.h) + " s)";
+                   fmt(per_cycle) + " steps per cycle (h = " + fmt(c.h) + " s)";
       hz.safe_setting =
           "solver.time_step <= " + fmt(1.0 / (kMinStepsPerCycle * law.vibration.frequency)) + " s";
       out.push_back(hz);
@@ -267,7 +267,7 @@ void checkSpawnStream(const CheckContext& c, std::size_t part, std::vector<Hazar
                    " s from a region " + fmt(across) + " m across, smaller than a part (" +
                    fmt(s_big) + " m), while a part needs " + fmt(clear_time) +
                    " s to fall clear of the next: parts appear inside each other and are "
-                   "pushed apart at c.up to solver.max_correcting_velocity";
+                   "pushed apart at up to solver.max_correcting_velocity";
       hz.safe_setting = idx("parts", i) + ".rate <= " + fmt(1.0 / clear_time) +
                         " parts/s, or a spawn region at least " + fmt(s_big) + " m across";
       out.push_back(hz);
@@ -313,7 +313,7 @@ void checkSpawnInsideFixture(const CheckContext& c, std::size_t part,
     hz.message = "the spawn region of " + idx("parts", i) + " ('" + p.name + "') reaches into " +
                  geomPath(gi.f, gi.g) + " (" + toString(gm.shape.kind) + ", fixture '" +
                  c.scene.fixtures[gi.f].name +
-                 "'): parts can start inside it and are pushed out at c.up to "
+                 "'): parts can start inside it and are pushed out at up to "
                  "solver.max_correcting_velocity or through it";
     hz.safe_setting = "move or shrink " + idx("parts", i) +
                       ".spawn_min/spawn_max so that part centres stay outside every fixture "

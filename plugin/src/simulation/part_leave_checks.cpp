@@ -98,18 +98,19 @@ bool PartSimulation::leftFeeder(std::size_t i, const PartState& s, std::string& 
 }
 
 void PartSimulation::checkPhysicalSpeed(std::size_t i, const PartState& s) {
-  Track& tr = tracks_[i];
+  const Track& tr = tracks_[i];
   const PartInstance& p = instances_[i];
   const double speed = energySpeed(s, p.mass, p.inertia);
   const double bound =
       partPhysicalSpeedBound(limits_, scene_.material.restitution, norm(scene_.gravity),
-                             tr.initial_speed, tr.spawn_height, dot(s.position, up_));
+                             limits_.initial_speed, top_spawn_height_, dot(s.position, up_));
   health_.max_speed_ratio = std::max(health_.max_speed_ratio, speed / bound);
   if (tr.counted || !(speed > bound)) return;
   std::ostringstream what;
   what << "moves at " << speed << " m/s (its kinetic energy as a speed), beyond its physical "
        << "bound " << bound << " m/s (" << kPhysicalSpeedFactor
-       << " x [(1 + e) (initial speed + free fall from its spawn height) + (1 + e) fastest "
+       << " x [(1 + e) (fastest initial speed + free fall from the highest spawn point) + (1 + e) "
+       << "fastest "
        << "surface " << limits_.surface_speed << " m/s + push-out " << limits_.correcting_speed
        << " m/s] + " << kPhysicalSpeedMargin << " m/s; kept)";
   countLoss(i, "too-fast part", what.str(), health_.parts_too_fast, s);

@@ -26,13 +26,14 @@
 // ## Physical speed bound (partPhysicalSpeedBound, issue 20)
 // The blow-up bound above is one number for the whole scene and must let a part fall from the
 // top of the scene to the removal height; a part in a trough 5 cm above its floor can be ten
-// times slower than that and still be beyond what its case allows. Each part is held to its
-// own energy budget instead: its kinetic energy per mass, as the speed v_e = sqrt(|v|^2 +
-// w.I w / m) it would have all in translation, can grow from its initial speed |v0| only by
-// its drop from its spawn height, sqrt(2 |g| (z0 - z)) (energy), by impacts on feeder surfaces
-// moving at up to V, which change the relative velocity by up to (1 + e) V, and by the
-// push-out of an overlap, capped at v_c per contact; an impact of a heavier part can pass its
-// speed on multiplied by up to (1 + e) (Newton's law for a light part hit by a heavy one):
+// times slower than that and still be beyond what its case allows. Each part is held to the
+// energy budget of its height instead: its kinetic energy per mass, as the speed v_e =
+// sqrt(|v|^2 + w.I w / m) it would have all in translation, comes from the fastest initial
+// speed |v0| of the scene, from a drop from the highest spawn point z0 to its height z,
+// sqrt(2 |g| (z0 - z)) (energy: its own fall or that of a part falling from z0 onto it, whose
+// speed an impact passes on multiplied by up to 1 + e, Newton's law for a light part hit by a
+// heavy one), from impacts on feeder surfaces moving at up to V, which change the relative
+// velocity by up to (1 + e) V, and from the push-out of an overlap, capped at v_c per contact:
 //   v_phys(z) = (1 + e) (|v0| + sqrt(2 |g| max(0, z0 - z))) + (1 + e) V + v_c.
 // kPhysicalSpeedFactor (25 %) and kPhysicalSpeedMargin (0.1 m/s) leave room for the contact
 // solvers' penetration recovery and the rounding of a part at rest; the shipped scenes and
@@ -324,6 +325,14 @@ PartSimulation::PartSimulation(const Scene& scene, Method method)
   health_.speed_bound = limits_.speed_bound;
   const double g = norm(scene.gravity);
   if (g > 0) up_ = (-1.0 / g) * scene.gravity;
+  top_spawn_height_ = -kInf;
+  for (const PartSpec& p : scene.parts) {  // the highest corner of every spawn region
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 corner{c & 1 ? p.spawn_max.x : p.spawn_min.x, c & 2 ? p.spawn_max.y : p.spawn_min.y,
+                        c & 4 ? p.spawn_max.z : p.spawn_min.z};
+      top_spawn_height_ = std::max(top_spawn_height_, dot(corner, up_));
+    }
+  }
   for (std::size_t f = 0; f < scene.fixtures.size(); ++f) {
     const FeederLaw& law = scene.fixtures[f].law;
     if (law.kind != FeederLaw::Kind::None) feeders_.push_back(static_cast<int>(f));
@@ -385,8 +394,6 @@ void PartSimulation::spawnDue() {
     partSizes(p.shape, tr.min_half_size, tr.radius);
     tr.last = partState(static_cast<int>(tracks_.size()));
     tr.beyond_exit = beyondExitPlane(scene_.outputs, tr.last.position);
-    tr.spawn_height = dot(tr.last.position, up_);
-    tr.initial_speed = norm(p.velocity);
     tracks_.push_back(tr);
   }
 }

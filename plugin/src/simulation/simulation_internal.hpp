@@ -93,9 +93,6 @@ class PartSimulation : public Simulation {
     bool inside = false;
     Vec3 entry_point, entry_normal;
     Vec3 outside_point;  // the last centre outside before it went in (m)
-    // Physical speed bound (RunHealth, "Too fast").
-    double spawn_height = 0;   // along up (m)
-    double initial_speed = 0;  // (m/s)
     // Left the feeder (RunHealth): touched a feeder; fixtures that supported it before that;
     // a fixture not among its carriers supported it in the last step.
     bool on_feeder = false;
@@ -144,6 +141,7 @@ class PartSimulation : public Simulation {
   std::vector<std::vector<Footprint>> footprints_;  // per fixture, per geom
   std::vector<int> feeders_;                        // fixtures with a law
   Vec3 up_{0, 0, 1};                                // -gravity, unit
+  double top_spawn_height_ = 0;  // the highest spawn point along up_ (m; physical speed bound)
   dGeomID ray_ = nullptr;                    // for firstCrossing, in no space
   std::vector<std::string> reported_;        // kinds already reported on stderr
   double time_ = 0;

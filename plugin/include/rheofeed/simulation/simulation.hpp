@@ -65,7 +65,8 @@ struct ContactTotals {
 /// speed with the kinetic energy in translation, sqrt(|v|^2 + w.I w / m), may not exceed
 ///   kPhysicalSpeedFactor [(1 + e) (|v0| + sqrt(2 |g| max(0, z0 - z))) + (1 + e) V + v_c]
 ///   + kPhysicalSpeedMargin
-/// with v0 its initial velocity, z0 its spawn height and z its height now (along -gravity), V
+/// with |v0| the fastest initial speed of the scene, z0 its highest spawn point (a part may be
+/// hit by one that fell from there) and z the part's height now (along -gravity), V
 /// the fastest feeder surface point (SceneLimits::surface_speed: belt speed, drift, vibration
 /// peak velocity), e the restitution and v_c the push-out speed cap
 /// (SolverSettings::max_correcting_velocity). A part above it is counted as too fast and kept;
@@ -189,10 +190,10 @@ constexpr double kSupportCosine = 0.5;
 /// (one: the farthest its centre can be while touching it; one more for hops at an edge).
 constexpr double kFootprintRadii = 2.0;
 
-/// The physical speed bound (m/s) of a part spawned at height `spawn_height` (m, along
-/// -gravity) with initial speed `initial_speed` (m/s), now at height `height` (m), in a scene
-/// with limits `limits`, restitution `restitution` and gravity `g` (m/s^2): RunHealth, "Too
-/// fast".
+/// The physical speed bound (m/s) of a part now at height `height` (m, along -gravity) in a
+/// scene with limits `limits`, restitution `restitution`, gravity `g` (m/s^2), fastest initial
+/// speed `initial_speed` (m/s) and highest spawn point `spawn_height` (m, along -gravity):
+/// RunHealth, "Too fast".
 double partPhysicalSpeedBound(const SceneLimits& limits, double restitution, double g,
                               double initial_speed, double spawn_height, double height);
 /// The speed (m/s) of a part of mass `mass` (kg) and body-frame inertia `inertia` (kg m^2,
