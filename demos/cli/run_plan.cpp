@@ -94,7 +94,13 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
   try {
     scene.validate();
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(where + ": " + e.what());
+    std::string hint;
+    if (args.duration_given && !args.warmup_given &&
+        std::string(e.what()).rfind("outputs.warmup", 0) == 0) {
+      hint = "; the scene's warmup is longer than the run: give --warmup 0 (or a warmup below " +
+             number(args.duration) + " s) with a short --duration";
+    }
+    throw std::invalid_argument(where + ": " + e.what() + hint);
   }
   for (Method m : methods) {
     PlannedRun run;
@@ -105,6 +111,13 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
     const double h = step.time_step;
     run.step_source = step.source();
     run.scene = atRunStep(scene, step);
+    if (run.scene.outputs.sample_interval != scene.outputs.sample_interval) {
+      std::fprintf(stderr,
+                   "rheofeed: %s: outputs.sample_interval = %s s is shorter than this run's step "
+                   "h = %s s (%s): it samples once per step, every %s s\n",
+                   toString(m), number(scene.outputs.sample_interval).c_str(), number(h).c_str(),
+                   run.step_source.c_str(), number(run.scene.outputs.sample_interval).c_str());
+    }
     try {
       run.scene.validate();
     } catch (const std::invalid_argument& e) {

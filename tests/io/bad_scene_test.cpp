@@ -274,6 +274,66 @@ TEST(SceneLimits, WarmupLongerThanTheDurationIsRefused) {
           {"must be <= duration - solver.time_step (0.999 s)", "no drift"});
 }
 
+// Issue 20: absurd values that were accepted without a word.
+
+TEST(SceneLimits, SampleIntervalShorterThanTheStepIsRefusedNamingBoth) {
+  refused(replaced(kGood, R"("sample_interval": 0.01)", R"("sample_interval": 1e-12)"),
+          "outputs.sample_interval", {"1e-12", ">= solver.time_step (0.001 s)"});
+}
+
+TEST(SceneLimits, AngleBeyondAMillionDegreesIsRefusedWithItsRange) {
+  refused(replaced(kGood, R"("angle_deg": 20)", R"("angle_deg": 1e300)"),
+          "fixtures[0].law.vibration.angle_deg", {"1e+300", "[-1000000, 1000000] degrees"});
+  refused(replaced(kGood, R"("angle_deg": 20)", R"("angle_rad": -1e7)"),
+          "fixtures[0].law.vibration.angle_rad", {"-10000000", "17453.29252", "rad"});
+  // The edge of the range is accepted.
+  EXPECT_NO_THROW(parseScene(replaced(kGood, R"("angle_deg": 20)", R"("angle_deg": 1e6)"), "ok"));
+}
+
+TEST(SceneLimits, GeomRotationAngleBeyondTheRangeIsRefused) {
+  refused(replaced(kGood, R"("position": [0, 1, -0.01]})",
+                   R"("position": [0, 1, -0.01], "rotation": {"axis": [0, 0, 1], "angle_deg": -2e6}})"),
+          "fixtures[1].geoms[0].rotation.angle_deg", {"-2000000", "degrees"});
+}
+
+TEST(SceneLimits, RemovalHeightAboveEverySpawnPointIsRefused) {
+  // The highest spawn point: parts[1] at z = 0.005 m.
+  refused(replaced(kGood, R"("removal_height": -1)", R"("removal_height": 0.01)"),
+          "removal_height", {"0.01", "above every spawn point", "z = 0.005 m"});
+  // Above one family's region only: accepted (the scene check warns, spawn_below_removal).
+  EXPECT_NO_THROW(
+      parseScene(replaced(kGood, R"("removal_height": -1)", R"("removal_height": 0.004)"), "ok"));
+}
+
+TEST(SceneLimits, HugeVectorMagnitudeIsPrintedAsANumber) {
+  // |(1e300, 1e300, 0)| = 1.414e300 is finite; its square is not.
+  try {
+    parseScene(replaced(kGood, R"("initial_velocity": [0, 0, 0])",
+                        R"("initial_velocity": [1e300, 1e300, 0])"),
+               "bad.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const SceneFileError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("1.41421e+300"), std::string::npos) << what;
+    EXPECT_EQ(what.find("inf"), std::string::npos) << what;
+  }
+}
+
+TEST(SceneFileLimits, SyntaxErrorQuotesAtMostALineOfContext) {
+  // An unterminated string of 444 000 characters: the lexer read all of it.
+  const std::string text = "{\"name\": \"" + std::string(444000, 'a') + "\n";
+  try {
+    parseScene(text, "bad.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const SceneFileError& e) {
+    const std::string what = e.what();
+    EXPECT_LT(what.size(), 300u) << what.substr(0, 300);
+    EXPECT_NE(what.find("syntax error"), std::string::npos) << what;
+    EXPECT_NE(what.find("last read: '..."), std::string::npos) << what;
+    EXPECT_EQ(e.line(), 1);
+  }
+}
+
 // ---- Distributions, spawn regions, counts, material ---------------------------------------------
 
 TEST(SceneLimits, MeanOutsideItsTruncationIsRefused) {

@@ -13,8 +13,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <random>
 
 #include "common/builtin_scenes.hpp"
+#include "mesh_shell.hpp"
+#include "rheofeed/scene/mesh.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 #include "rheofeed/simulation/simulation.hpp"
 
@@ -346,6 +349,99 @@ TEST(SceneCheck, DemoScenesAreQuietAtTheirSteps) {
   // The bowl's file says that nuts tunnel through its 4 mm ramp at the runner's default 0.01 s.
   bowl.solver.time_step = 0.01;
   EXPECT_EQ(ofKind(checkScene(bowl, Method::OdeRheonomic), Hazard::Kind::Tunnelling).size(), 1u);
+}
+
+// ---- Mesh wall thickness ---------------------------------------------------------------------
+
+// The all-pairs wall-thickness test the check used before issue 20 (O(n^2)), kept as the
+// reference the tree search must equal exactly.
+double allPairsWallThickness(const TriangleMesh& mesh, double scale) {
+  const std::vector<double>& v = mesh.vertices;
+  const std::vector<int>& t = mesh.triangles;
+  auto vert = [&](int i) { return scale * Vec3{v[3 * i], v[3 * i + 1], v[3 * i + 2]}; };
+  const std::size_t n = t.size() / 3;
+  std::vector<std::pair<double, double>> walls;  // thickness, area
+  double total_area = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 a = vert(t[3 * i]), b = vert(t[3 * i + 1]), c = vert(t[3 * i + 2]);
+    const Vec3 normal = cross(b - a, c - a);
+    const double area2 = norm(normal);
+    if (!(area2 > 0)) continue;
+    const Vec3 dir = (-1.0 / area2) * normal;  // inwards
+    const Vec3 origin = (1.0 / 3.0) * (a + b + c);
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j == i) continue;
+      const Vec3 p = vert(t[3 * j]), q = vert(t[3 * j + 1]), r = vert(t[3 * j + 2]);
+      const Vec3 e1 = q - p, e2 = r - p, pv = cross(dir, e2);
+      const double det = dot(e1, pv);
+      if (std::abs(det) < 1e-30) continue;
+      const Vec3 tv = origin - p;
+      const double u = dot(tv, pv) / det;
+      if (u < 0 || u > 1) continue;
+      const Vec3 qv = cross(tv, e1);
+      const double w = dot(dir, qv) / det;
+      if (w < 0 || u + w > 1) continue;
+      const double dist = dot(e2, qv) / det;
+      if (dist > 1e-9 * std::sqrt(area2)) nearest = std::min(nearest, dist);
+    }
+    total_area += 0.5 * area2;
+    if (std::isfinite(nearest)) walls.emplace_back(nearest, 0.5 * area2);
+  }
+  std::sort(walls.begin(), walls.end());
+  double area = 0;
+  for (const auto& [thickness, a] : walls) {
+    area += a;
+    if (area >= kThinShare * total_area) return thickness;
+  }
+  return walls.empty() ? 0 : walls.back().first;
+}
+
+// 400 random triangles in a 10 cm cube: no wall at all, rays crossing every which way.
+TriangleMesh triangleSoup() {
+  std::mt19937 gen(7);
+  std::uniform_real_distribution<double> x(0, 0.1);
+  TriangleMesh m;
+  for (int k = 0; k < 1200; ++k) {
+    m.vertices.insert(m.vertices.end(), {x(gen), x(gen), x(gen)});
+    m.triangles.push_back(k);
+  }
+  return m;
+}
+
+TEST(SceneCheck, MeshWallThicknessEqualsTheAllPairsTestExactly) {
+  const TriangleMesh bowl = loadTriangleMesh(
+      std::filesystem::path(RHEOFEED_DEMO_DIR) / "meshes" / "vibratory_bowl.stl");
+  const TriangleMesh shell = testing::sphericalShell(0.1, 0.09, 24, 12);
+  const TriangleMesh soup = triangleSoup();
+  for (const TriangleMesh* m : {&bowl, &shell, &soup}) {
+    for (double scale : {1.0, 0.001}) {
+      SCOPED_TRACE(m->source + " x " + std::to_string(scale));
+      const MeshWallThickness fast = meshWallThickness(*m, scale);
+      EXPECT_TRUE(fast.measured);
+      EXPECT_EQ(fast.thickness, allPairsWallThickness(*m, scale));  // bit for bit
+    }
+  }
+  // The demo bowl's thinnest real wall is its 4 mm ramp (see check.hpp).
+  EXPECT_NEAR(meshWallThickness(bowl, 0.001).thickness, 0.004, 0.0005);  // the STL is in mm
+}
+
+TEST(SceneCheck, MeshWallThicknessOfASphericalShellIsItsWall) {
+  // 10 mm wall; the facets of 48 x 48 sphere sides sit up to r (1 - cos(pi / 48)) inside their
+  // spheres: 0.21 mm for the outer one.
+  const double outer = 0.1, inner = 0.09;
+  const double facet = outer * (1 - std::cos(std::acos(-1.0) / 48));
+  const MeshWallThickness wall =
+      meshWallThickness(testing::sphericalShell(outer, inner, 48, 48), 1.0);
+  ASSERT_TRUE(wall.measured);
+  EXPECT_NEAR(wall.thickness, outer - inner, 2 * facet);
+}
+
+TEST(SceneCheck, MeshWallThicknessBeyondItsWorkLimitIsSkippedAndSaid) {
+  const MeshWallThickness wall =
+      meshWallThickness(testing::sphericalShell(0.1, 0.09, 24, 12), 1.0, 1000);
+  EXPECT_FALSE(wall.measured);
+  EXPECT_GT(wall.ray_tests, 1000);
 }
 
 }  // namespace

@@ -347,21 +347,23 @@ TEST(RunHealth, JsonAndCsvCarryTheCounts) {
   EXPECT_EQ(h.at("parts_out_of_bounds").get<int>(), 0);
   EXPECT_EQ(h.at("parts_nonfinite").get<int>(), 0);
   EXPECT_EQ(h.at("parts_too_fast").get<int>(), 0);
+  EXPECT_EQ(h.at("parts_left_feeder").get<int>(), 0);  // no feeder to leave
+  EXPECT_LT(h.at("max_physical_speed_ratio").get<double>(), 1.0);
   EXPECT_EQ(h.at("steps").get<long>(), std::lround(s.duration / s.solver.time_step));
   EXPECT_EQ(h.at("coulomb_fallback_steps").get<long>(), 0);
   ASSERT_EQ(h.at("ignored_settings").size(), 1u);
   EXPECT_NE(h.at("ignored_settings")[0].get<std::string>().find("coulomb_iterations"),
             std::string::npos);
 
-  // The CSV's last row: lost_fell = 1, nothing else lost.
+  // The CSV's last row: lost_fell = 1, nothing else lost (lost_left_feeder last).
   std::istringstream csv(seriesCsv(r));
   std::string header, line, last;
   std::getline(csv, header);
   EXPECT_NE(header.find(",lost_fell,lost_through_fixture,lost_out_of_bounds,lost_nonfinite,"
-                        "lost_too_fast"),
+                        "lost_too_fast,lost_left_feeder"),
             std::string::npos);
   while (std::getline(csv, line)) last = line;
-  EXPECT_EQ(last.substr(last.size() - 10), ",1,0,0,0,0");
+  EXPECT_EQ(last.substr(last.size() - 12), ",1,0,0,0,0,0");
 }
 
 TEST(RunHealth, ReferenceJsonCountsFallbackStepsAsTheWorldReportsThem) {

@@ -289,6 +289,7 @@ class RunMeter : public RunObserver {
     s.out_of_bounds = health.parts_out_of_bounds;
     s.nonfinite = health.parts_nonfinite;
     s.too_fast = health.parts_too_fast;
+    s.left_feeder = health.parts_left_feeder;
     m_.series.push_back(s);
   }
   void finishDrift(const Simulation& sim) {

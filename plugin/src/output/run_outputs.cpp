@@ -12,12 +12,12 @@ namespace rheofeed::scene {
 std::string seriesCsv(const RunMetrics& run) {
   std::ostringstream s;
   s << "time_s,parts,mean_velocity_mps,ci95_mps,mean_height_m,exited,lost_fell,"
-       "lost_through_fixture,lost_out_of_bounds,lost_nonfinite,lost_too_fast\n";
+       "lost_through_fixture,lost_out_of_bounds,lost_nonfinite,lost_too_fast,lost_left_feeder\n";
   char line[256];
   for (const DriftSample& d : run.series) {
-    std::snprintf(line, sizeof line, "%.6f,%d,%.8g,%.8g,%.8g,%d,%d,%d,%d,%d,%d\n", d.time, d.parts,
+    std::snprintf(line, sizeof line, "%.6f,%d,%.8g,%.8g,%.8g,%d,%d,%d,%d,%d,%d,%d\n", d.time, d.parts,
                   d.mean_velocity, d.ci95, d.mean_height, d.exited, d.fell, d.through_fixture,
-                  d.out_of_bounds, d.nonfinite, d.too_fast);
+                  d.out_of_bounds, d.nonfinite, d.too_fast, d.left_feeder);
     s << line;
   }
   return s.str();
@@ -46,16 +46,18 @@ std::string summaryJson(const RunMetrics& r) {
       ", \"health\": {\"steps\": %ld, \"parts_removed_after_exit\": %d, \"parts_lost\": %d, "
       "\"parts_fell\": %d, \"parts_through_fixture\": %d, \"parts_out_of_bounds\": %d, "
       "\"parts_nonfinite\": %d, \"parts_too_fast\": %d, \"parts_inside_fixture\": %d, "
-      "\"parts_sunk\": %d, "
+      "\"parts_left_feeder\": %d, \"parts_sunk\": %d, "
       "\"coulomb_fallback_steps\": %ld, "
       "\"coulomb_fallback_share\": %.6g, \"solver_unconverged_steps\": %ld, "
       "\"friction_dropped_contacts\": %ld, \"gyroscopic_fallback_steps\": %ld, "
-      "\"max_part_speed_mps\": %.6g, \"speed_bound_mps\": %.6g, \"ignored_settings\": [",
+      "\"max_part_speed_mps\": %.6g, \"speed_bound_mps\": %.6g, "
+      "\"max_physical_speed_ratio\": %.6g, \"ignored_settings\": [",
       h.steps, h.parts_exited, h.partsLost(), h.parts_fell, h.parts_through_fixture,
       h.parts_out_of_bounds, h.parts_nonfinite, h.parts_too_fast, h.parts_inside_fixture,
-      h.parts_sunk, h.coulomb_fallback_steps,
+      h.parts_left_feeder, h.parts_sunk, h.coulomb_fallback_steps,
       h.steps > 0 ? double(h.coulomb_fallback_steps) / h.steps : 0.0, h.solver_unconverged_steps,
-      h.friction_dropped_contacts, h.gyroscopic_fallback_steps, h.max_part_speed, h.speed_bound);
+      h.friction_dropped_contacts, h.gyroscopic_fallback_steps, h.max_part_speed, h.speed_bound,
+      h.max_speed_ratio);
   std::string json = "{\"scene\": " + jsonQuoted(r.scene) + run + c;
   for (std::size_t k = 0; k < h.ignored_settings.size(); ++k) {
     json += (k ? ", " : "") + jsonQuoted(h.ignored_settings[k]);

@@ -77,7 +77,10 @@ void size(const std::string& path, double v) {
 // |v| of a vector of finite components, with `what` naming the bound ("m/s").
 void magnitude(const std::string& path, const Vec3& v, double max, const std::string& unit) {
   finite(path, v);
-  const double n = norm(v);
+  // |v| scaled by its largest component, so that a magnitude beyond sqrt(DBL_MAX) (1e300) is
+  // computed as a number, not as inf.
+  const double big = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+  const double n = big > 0 ? big * norm((1.0 / big) * v) : 0.0;
   if (!(n <= max)) {
     bad(path + " magnitude", n, "must be <= " + show(max) + " " + unit);
   }
@@ -307,6 +310,11 @@ void Scene::validate() const {
   }
   unit("outputs.conveying_direction", outputs.conveying_direction);
   positive("outputs.sample_interval", outputs.sample_interval);
+  if (outputs.sample_interval < solver.time_step) {
+    bad("outputs.sample_interval", outputs.sample_interval,
+        "must be >= solver.time_step (" + show(solver.time_step) +
+            " s): a run samples at most once per step");
+  }
   if (outputs.sample_interval > duration) {
     bad("outputs.sample_interval", outputs.sample_interval,
         "must be <= duration (" + show(duration) + " s): the run would take no sample");
@@ -365,7 +373,8 @@ void Scene::validate() const {
         positive(vp + ".frequency", v.frequency);
         within(vp + ".frequency", v.frequency, 0, limits::kMaxFrequency, "Hz");
         unit(vp + ".direction", v.direction);
-        finite(vp + ".phase", v.phase);
+        within(vp + ".phase", v.phase, -limits::kMaxAngle, limits::kMaxAngle, "rad",
+               "1e6 degrees: beyond, a double no longer resolves the angle to a degree's 1e-10");
         within(vp + ".torsion_amplitude", v.torsion_amplitude, 0, limits::kMaxTorsion, "rad");
         position(vp + ".axis_origin", v.axis_origin);
         unit(vp + ".axis_direction", v.axis_direction);
@@ -449,6 +458,14 @@ void Scene::validate() const {
     }
     nonNegative(path + ".rate", p.rate);
     magnitude(path + ".initial_velocity", p.initial_velocity, limits::kMaxSpeed, "m/s");
+  }
+  double highest_spawn = -HUGE_VAL;  // removal_height is a world z (simulation.hpp)
+  for (const PartSpec& p : parts) highest_spawn = std::max(highest_spawn, p.spawn_max.z);
+  if (highest_spawn < removal_height) {
+    bad("removal_height", removal_height,
+        "is above every spawn point (the highest, parts[].spawn_max.z, is at z = " +
+            show(highest_spawn) +
+            " m): every part would be removed as it spawns and nothing would be simulated");
   }
   (void)localEfficiencies(fixtures, parts.size(), parts);  // local feeders agree per family
 }

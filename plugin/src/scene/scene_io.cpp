@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Scene files (JSON): text -> DOM (with paths, duplicate keys and overflowing numbers caught by
 // a SAX handler) -> Scene (every value type- and range-checked, unknown keys refused) ->
-// Scene::validate() -> meshes -> drawParts. Scene -> JSON is scene_io_write.cpp. The format is
-// documented in demos/scenes/README.md; the key names follow the field names of scene.hpp.
+// Scene::validate() -> meshes -> drawParts. This file reads the DOM into a Scene; text -> DOM is
+// scene_io_json.cpp, the meshes scene_io_mesh.cpp, Scene -> JSON scene_io_write.cpp. The format
+// is documented in demos/scenes/README.md; the key names follow the field names of scene.hpp.
 #include "rheofeed/scene/scene_io.hpp"
 
 #include <Eigen/Geometry>
@@ -18,171 +19,21 @@
 #include <vector>
 
 #include "rheofeed/scene/mesh.hpp"
+#include "scene_io_internal.hpp"
 #include "scene_limits.hpp"
 
 namespace rheofeed::scene {
 namespace {
 
 namespace fs = std::filesystem;
-using json = nlohmann::json;
-using ojson = nlohmann::ordered_json;
+using io::describe;
+using io::fail;
+using io::json;
+using io::parseText;
+using io::show;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kFormatVersion = 1;
-
-[[noreturn]] void fail(const std::string& path, const std::string& problem) {
-  throw SceneFileError("", path, problem);
-}
-
-std::string describe(const json& v) {
-  if (v.is_object()) return "an object";
-  if (v.is_array()) return "an array of " + std::to_string(v.size());
-  std::string s = v.dump();
-  return s.size() > 40 ? s.substr(0, 37) + "..." : s;
-}
-
-std::string show(double v) {
-  std::ostringstream out;
-  out.precision(10);
-  out << v;
-  return out.str();
-}
-
-// ---- Text to DOM -------------------------------------------------------------------------------
-
-// Builds the DOM like nlohmann's own parser, and besides knows the JSON path of the value being
-// read, so that a duplicate key or a number that overflows a double (1e999) is reported with it.
-class DomBuilder final : public nlohmann::json_sax<json> {
- public:
-  explicit DomBuilder(json& root) : root_(root) {}
-
-  bool null() override { return value(nullptr); }
-  bool boolean(bool v) override { return value(v); }
-  bool number_integer(number_integer_t v) override { return value(v); }
-  bool number_unsigned(number_unsigned_t v) override { return value(v); }
-  bool number_float(number_float_t v, const string_t&) override { return value(v); }
-  bool string(string_t& v) override { return value(v); }
-  bool binary(binary_t&) override { return value(nullptr); }  // never in JSON text
-  bool start_object(std::size_t) override { return open(json::object()); }
-  bool end_object() override { return close(); }
-  bool start_array(std::size_t) override { return open(json::array()); }
-  bool end_array() override { return close(); }
-  bool key(string_t& k) override {
-    Frame& f = frames_.back();
-    if (!f.keys.insert(k).second) {
-      path_ = join(pathOf(frames_.size() - 1), k);
-      problem_ = "duplicate key (each key may appear once per object)";
-      return false;
-    }
-    f.key = k;
-    slot_ = &(*containers_.back())[k];
-    return true;
-  }
-  bool parse_error(std::size_t byte, const std::string& token,
-                   const nlohmann::json::exception& e) override {
-    byte_ = byte;
-    if (e.id == 406) {  // out_of_range.406: number overflow
-      path_ = pathOf(frames_.size());
-      problem_ = "the number " + token + " is not finite (it overflows a double)";
-    } else {  // drop nlohmann's "[json.exception...] parse error at line L, column C: "
-      std::string what = e.what();
-      const std::size_t column = what.find("column ");
-      const std::size_t colon = what.find(": ", column == std::string::npos ? 0 : column);
-      if (colon != std::string::npos) what.erase(0, colon + 2);
-      problem_ = what.rfind("syntax error", 0) == 0 ? "JSON " + what : "JSON syntax error: " + what;
-    }
-    return false;
-  }
-
-  const std::string& path() const { return path_; }
-  const std::string& problem() const { return problem_; }
-  std::size_t byte() const { return byte_; }
-
- private:
-  struct Frame {
-    bool array = false;
-    std::size_t index = 0;  // array: index of the element being read
-    std::string key;        // object: key of the element being read
-    std::set<std::string> keys;
-  };
-
-  static std::string join(const std::string& path, const std::string& key) {
-    return path.empty() ? key : path + "." + key;
-  }
-  // The path of the element being read at depth n (n frames).
-  std::string pathOf(std::size_t n) const {
-    std::string p;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Frame& f = frames_[i];
-      if (f.array) {
-        p += "[" + std::to_string(f.index) + "]";
-      } else if (!f.key.empty()) {
-        p = join(p, f.key);
-      }
-    }
-    return p;
-  }
-  json* place(json v) {
-    if (containers_.empty()) {
-      root_ = std::move(v);
-      return &root_;
-    }
-    json& top = *containers_.back();
-    if (top.is_array()) {
-      top.push_back(std::move(v));
-      return &top.back();
-    }
-    *slot_ = std::move(v);
-    return slot_;
-  }
-  void elementDone() {
-    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
-  }
-  bool value(json v) {
-    place(std::move(v));
-    elementDone();
-    return true;
-  }
-  bool open(json v) {
-    const bool array = v.is_array();
-    containers_.push_back(place(std::move(v)));
-    frames_.push_back(Frame{array, 0, {}, {}});
-    return true;
-  }
-  bool close() {
-    containers_.pop_back();
-    frames_.pop_back();
-    elementDone();
-    return true;
-  }
-
-  json& root_;
-  std::vector<json*> containers_;  // open objects and arrays, innermost last
-  std::vector<Frame> frames_;
-  json* slot_ = nullptr;  // the value slot of the last key read
-  std::string path_, problem_;
-  std::size_t byte_ = 0;
-};
-
-json parseText(const std::string& text) {
-  json root;
-  DomBuilder builder(root);
-  if (json::sax_parse(text, &builder)) return root;
-  int line = 0, column = 0;
-  if (builder.byte() > 0) {  // byte: characters read when the error was found
-    const std::size_t end = std::min(builder.byte(), text.size());
-    line = 1;
-    std::size_t line_start = 0;
-    for (std::size_t i = 0; i + 1 < end; ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        line_start = i + 1;
-      }
-    }
-    column = std::max(1, static_cast<int>(end - line_start));
-  }
-  throw SceneFileError("", builder.path(), builder.problem(), line, column);
-}
 
 // ---- DOM to values -----------------------------------------------------------------------------
 
@@ -297,6 +148,15 @@ void read(const json& v, const std::string& path, Distribution& out);
 void read(const json& v, const std::string& path, Twist& out);
 void read(const json& v, const std::string& path, Pose& out);
 
+// |angle| within the scene files' range (scene_limits.hpp, kMaxAngleDegrees).
+void checkAngle(const std::string& path, double angle, double max, const char* unit) {
+  if (!(std::abs(angle) <= max)) {
+    fail(path, "must be in [-" + show(max) + ", " + show(max) + "] " + unit +
+                   " (1e6 degrees: a double resolves no finer angle there than 1e-10 degree), "
+                   "got " + show(angle));
+  }
+}
+
 // A JSON object being read: every key asked for is remembered, and finish() refuses the rest.
 class Object {
  public:
@@ -343,9 +203,11 @@ class Object {
     if (d && r) fail(at(deg), "give either " + deg + " or " + rad + ", not both");
     if (d) {
       read(*d, at(deg), out_rad, range);
+      checkAngle(at(deg), out_rad, limits::kMaxAngleDegrees, "degrees");
       out_rad *= kPi / 180;
     } else if (r) {
       read(*r, at(rad), out_rad, range);
+      checkAngle(at(rad), out_rad, limits::kMaxAngle, "rad");
     }
     return d || r;
   }
@@ -765,98 +627,7 @@ Scene readScene(const json& root) {
   fail(path, rest);
 }
 
-// A fixture mesh, scaled: its bounding box diagonal within the size limits and, placed at
-// `position`, every vertex within the coordinate limits (scene.hpp).
-void checkFixtureMesh(const TriangleMesh& mesh, const Vec3& position, const std::string& path) {
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  for (std::size_t v = 0; v + 2 < mesh.vertices.size(); v += 3) {
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], mesh.vertices[v + k]);
-      hi[k] = std::max(hi[k], mesh.vertices[v + k]);
-    }
-  }
-  const double diagonal = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-  const std::string name = "mesh '" + mesh.source + "'";
-  auto range = [](double low, double high) {  // as Scene::validate writes its ranges
-    std::ostringstream out;
-    out << "[" << low << ", " << high << "] m";
-    return out.str();
-  };
-  if (!(diagonal >= limits::kMinSize && diagonal <= limits::kMaxSize)) {
-    fail(path, name + ": scaled bounding box diagonal " + show(diagonal) + " m must be in " +
-                   range(limits::kMinSize, limits::kMaxSize));
-  }
-  // The geom may be rotated: bound every vertex by the farthest one from the mesh origin.
-  const double reach = boundingRadius(mesh);
-  const double p[3] = {position.x, position.y, position.z};
-  for (int k = 0; k < 3; ++k) {
-    if (!(std::abs(p[k]) + reach <= limits::kMaxCoordinate)) {
-      fail(path, name + ": vertices reach " + show(std::abs(p[k]) + reach) +
-                     " m from the origin along " + std::string(1, "xyz"[k]) +
-                     "; coordinates must be in " +
-                     range(-limits::kMaxCoordinate, limits::kMaxCoordinate));
-    }
-  }
-}
-
 }  // namespace
-
-SceneFileError::SceneFileError(std::string source, std::string path, std::string problem, int line,
-                               int column)
-    : std::invalid_argument([&] {
-        std::string s = source;
-        if (line > 0) s += ":" + std::to_string(line) + ":" + std::to_string(column);
-        if (!path.empty()) s += (s.empty() ? "" : ": ") + path;
-        return s + (s.empty() ? "" : ": ") + problem;
-      }()),
-      source_(std::move(source)),
-      path_(std::move(path)),
-      problem_(std::move(problem)),
-      line_(line),
-      column_(column) {}
-
-void loadSceneMeshes(Scene& scene, const fs::path& base_dir, const MeshLoader& mesh_loader) {
-  const MeshLoader load = mesh_loader ? mesh_loader : MeshLoader(loadTriangleMesh);
-  std::map<std::pair<std::string, double>, std::shared_ptr<const TriangleMesh>> cache;
-  auto get = [&](std::string& file, double scale, const std::string& path) {
-    fs::path p(file);
-    if (p.is_relative()) p = base_dir / p;
-    file = fs::absolute(p).lexically_normal().string();
-    std::shared_ptr<const TriangleMesh>& mesh = cache[{file, scale}];
-    if (!mesh) {
-      try {
-        TriangleMesh m = load(file, scale);
-        if (m.source.empty()) m.source = file;
-        mesh = std::make_shared<const TriangleMesh>(std::move(m));
-      } catch (const std::exception& e) {
-        fail(path, e.what());
-      }
-    }
-    return mesh;
-  };
-  for (std::size_t i = 0; i < scene.fixtures.size(); ++i) {
-    for (std::size_t g = 0; g < scene.fixtures[i].geoms.size(); ++g) {
-      Shape& s = scene.fixtures[i].geoms[g].shape;
-      if (s.kind != Shape::Kind::Mesh) continue;
-      const std::string path =
-          "fixtures[" + std::to_string(i) + "].geoms[" + std::to_string(g) + "].mesh";
-      s.mesh_data = get(s.mesh, s.mesh_scale, path);
-      checkFixtureMesh(*s.mesh_data, scene.fixtures[i].geoms[g].pose.position, path);
-    }
-  }
-  for (std::size_t i = 0; i < scene.parts.size(); ++i) {
-    PartSpec& p = scene.parts[i];
-    if (p.shape != Shape::Kind::Mesh) continue;
-    const std::string path = "parts[" + std::to_string(i) + "].mesh";
-    const std::shared_ptr<const TriangleMesh> mesh = get(p.mesh, 1.0, path);
-    try {  // a part must be a closed, outward-oriented solid; centre it on its centre of mass
-      const MassProperties mp = massProperties(*mesh, 1.0);
-      p.mesh_data = std::make_shared<const TriangleMesh>(translateMesh(*mesh, -mp.centre_of_mass));
-    } catch (const std::exception& e) {
-      fail(path, e.what());
-    }
-  }
-}
 
 Scene parseScene(const std::string& json_text, const std::string& source_name,
                  const MeshLoader& mesh_loader) {

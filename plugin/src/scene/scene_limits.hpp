@@ -50,6 +50,12 @@ constexpr double kMaxFrequency = 1e5;
 // larger amplitude is almost certainly degrees given as radians).
 constexpr double kMaxTorsion = 3.14159265358979323846;
 
+// Angles given in scene files (rotations, throw angles, phases), degrees: |angle| <= 1e6
+// degrees (2778 turns). A double resolves 1e6 degrees to 1.1e-10 degree; an angle of 1e300
+// (issue 20) is a multiple of 360 degrees to the last bit and means nothing. In radians:
+constexpr double kMaxAngleDegrees = 1e6;
+constexpr double kMaxAngle = kMaxAngleDegrees * 3.14159265358979323846 / 180;
+
 // Time step, s: 1 us (a 1e-12 s step "hung" a run: 1e12 steps per simulated second) to 1 s
 // (20x the largest step the stability matrix of issue 7 tries, 0.05 s).
 constexpr double kMinTimeStep = 1e-6;

@@ -66,7 +66,7 @@ class OdeSimulation final : public PartSimulation {
         } else if (f.law.kind != FeederLaw::Kind::None) {
           feeders_->add(geom, law);
         }
-        addFixtureGeom(geom);
+        addFixtureGeom(geom, static_cast<int>(fi));
       }
     }
 
@@ -204,7 +204,9 @@ class OdeSimulation final : public PartSimulation {
     toOdeMatrix(p.pose, r);
     dBodySetRotation(b, r);
     dBodySetLinearVel(b, p.velocity.x, p.velocity.y, p.velocity.z);
-    dGeomSetBody(createGeom(space_, p.shape, meshes_), b);
+    dGeomID geom = createGeom(space_, p.shape, meshes_);
+    dGeomSetBody(geom, b);
+    addPartGeom(geom, static_cast<int>(parts_.size()));
     const double efficiency = partEfficiency(p.spec);
     if (efficiency != 1.0) feeders_->setPartEfficiency(b, efficiency);
     parts_.push_back(b);
@@ -225,6 +227,16 @@ class OdeSimulation final : public PartSimulation {
       totals.impulse = totals.impulse + impulse;
     }
     return totals;
+  }
+
+  std::vector<FixtureContact> fixtureContacts() const override {
+    std::vector<FixtureContact> out;
+    for (const ContactCollider::Joint& j : collider_->joints()) {
+      const bool f1 = isFixture(j.g1), f2 = isFixture(j.g2);
+      if (f1 == f2) continue;  // part-part or fixture-fixture
+      out.push_back(f1 ? FixtureContact{j.g2, j.g1, -j.normal} : FixtureContact{j.g1, j.g2, j.normal});
+    }
+    return out;
   }
 
   TriMeshStore meshes_;  // trimesh data of the mesh geoms; outlives space_ (see the destructor)

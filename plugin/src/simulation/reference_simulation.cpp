@@ -51,7 +51,7 @@ class ReferenceSimulation final : public PartSimulation {
         } else if (f.law.kind != FeederLaw::Kind::None) {
           world_->setFeeder(geom, law);
         }
-        addFixtureGeom(geom);
+        addFixtureGeom(geom, static_cast<int>(fi));
       }
     }
     listIgnoredSettings();
@@ -127,7 +127,9 @@ class ReferenceSimulation final : public PartSimulation {
     state.linear_velocity = p.velocity;
     state.orientation = reference::toQuat(p.pose);
     const BodyId body = world_->addBody(p.mass, p.inertia, state);
-    world_->attachGeom(createGeom(world_->space(), p.shape, meshes_), body);
+    dGeomID geom = createGeom(world_->space(), p.shape, meshes_);
+    world_->attachGeom(geom, body);
+    addPartGeom(geom, static_cast<int>(parts_.size()));
     const double efficiency = partEfficiency(p.spec);
     if (efficiency != 1.0) world_->setBodyEfficiency(body, efficiency);
     parts_.push_back(body);
@@ -146,6 +148,16 @@ class ReferenceSimulation final : public PartSimulation {
       totals.impulse = totals.impulse + impulse;
     }
     return totals;
+  }
+
+  std::vector<FixtureContact> fixtureContacts() const override {
+    std::vector<FixtureContact> out;
+    for (const reference::ContactImpulse& c : world_->contacts()) {
+      const bool f1 = isFixture(c.g1), f2 = isFixture(c.g2);
+      if (f1 == f2) continue;
+      out.push_back(f1 ? FixtureContact{c.g2, c.g1, -c.normal} : FixtureContact{c.g1, c.g2, c.normal});
+    }
+    return out;
   }
 
   // Settings of the scene the reference world does not read, when they differ from their

@@ -75,6 +75,7 @@ std::string healthSummary(const RunHealth& h, int parts) {
     s << h.partsLost() << " of " << parts << " parts lost (";
     const std::pair<const char*, int> kinds[] = {{"fell", h.parts_fell},
                                                  {"through a fixture", h.parts_through_fixture},
+                                                 {"left the feeder", h.parts_left_feeder},
                                                  {"out of bounds", h.parts_out_of_bounds},
                                                  {"non-finite", h.parts_nonfinite},
                                                  {"too fast", h.parts_too_fast},
@@ -87,7 +88,8 @@ std::string healthSummary(const RunHealth& h, int parts) {
     }
     s << ")";
     if (h.parts_too_fast > 0) {
-      s << ", max speed " << h.max_part_speed << " m/s (bound " << h.speed_bound << " m/s)";
+      s << ", max speed " << h.max_part_speed << " m/s (blow-up bound " << h.speed_bound
+        << " m/s), up to " << h.max_speed_ratio << " x a part's physical bound";
     }
     separator = "; ";
   }

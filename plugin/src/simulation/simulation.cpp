@@ -23,6 +23,22 @@
 // covers while it falls from z_top to the removal height; upwards at least the height a part at
 // v_phys can climb (v_phys^2 / 2 |g|). Downwards Scene::removal_height takes parts out.
 //
+// ## Physical speed bound (partPhysicalSpeedBound, issue 20)
+// The blow-up bound above is one number for the whole scene and must let a part fall from the
+// top of the scene to the removal height; a part in a trough 5 cm above its floor can be ten
+// times slower than that and still be beyond what its case allows. Each part is held to the
+// energy budget of its height instead: its kinetic energy per mass, as the speed v_e =
+// sqrt(|v|^2 + w.I w / m) it would have all in translation, comes from the fastest initial
+// speed |v0| of the scene, from a drop from the highest spawn point z0 to its height z,
+// sqrt(2 |g| (z0 - z)) (energy: its own fall or that of a part falling from z0 onto it, whose
+// speed an impact passes on multiplied by up to 1 + e, Newton's law for a light part hit by a
+// heavy one), from impacts on feeder surfaces moving at up to V, which change the relative
+// velocity by up to (1 + e) V, and from the push-out of an overlap, capped at v_c per contact:
+//   v_phys(z) = (1 + e) (|v0| + sqrt(2 |g| max(0, z0 - z))) + (1 + e) V + v_c.
+// kPhysicalSpeedFactor (25 %) and kPhysicalSpeedMargin (0.1 m/s) leave room for the contact
+// solvers' penetration recovery and the rounding of a part at rest; the shipped scenes and
+// tests stay below (RunHealth::max_speed_ratio in their JSON).
+//
 // ## Tunnelling
 // A part's centre never reaches a fixture surface in contact (it stays at least its smallest
 // half-size away, less the penetration). When it moves by more than kTunnelCheckFraction of
@@ -189,13 +205,13 @@ void partSizes(const Shape& s, double& min_half, double& radius) {
   min_half = radius = 0;
 }
 
+}  // namespace
+
 std::string formatPosition(const Vec3& x) {
   char b[96];
   std::snprintf(b, sizeof b, "(%.6g, %.6g, %.6g) m", x.x, x.y, x.z);
   return b;
 }
-
-}  // namespace
 
 void PartSimulation::markNonFinite(int index) {
   tracks_.at(static_cast<std::size_t>(index)).engine_nonfinite = true;
@@ -283,9 +299,55 @@ double partSpeed(const PartState& s, double radius) {
   return norm(s.velocity) + norm(s.angular_velocity) * radius;
 }
 
+double partPhysicalSpeedBound(const SceneLimits& limits, double restitution, double g,
+                              double initial_speed, double spawn_height, double height) {
+  const double fall = std::sqrt(2 * g * std::max(0.0, spawn_height - height));
+  const double physical = (1 + restitution) * (initial_speed + fall) +
+                          (1 + restitution) * limits.surface_speed + limits.correcting_speed;
+  return kPhysicalSpeedFactor * physical + kPhysicalSpeedMargin;
+}
+
+double energySpeed(const PartState& s, double mass, const double inertia[9]) {
+  const double* r = s.rotation;  // body to world: w_body = R^T w
+  const Vec3& w = s.angular_velocity;
+  const double b[3] = {r[0] * w.x + r[3] * w.y + r[6] * w.z, r[1] * w.x + r[4] * w.y + r[7] * w.z,
+                       r[2] * w.x + r[5] * w.y + r[8] * w.z};
+  double wiw = 0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) wiw += b[i] * inertia[3 * i + j] * b[j];
+  }
+  const double v = norm(s.velocity);
+  return mass > 0 ? std::sqrt(v * v + std::max(0.0, wiw) / mass) : v;
+}
+
 PartSimulation::PartSimulation(const Scene& scene, Method method)
     : scene_(scene), method_(method), instances_(drawParts(scene)), limits_(sceneLimits(scene)) {
   health_.speed_bound = limits_.speed_bound;
+  const double g = norm(scene.gravity);
+  if (g > 0) up_ = (-1.0 / g) * scene.gravity;
+  top_spawn_height_ = -kInf;
+  for (const PartSpec& p : scene.parts) {  // the highest corner of every spawn region
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 corner{c & 1 ? p.spawn_max.x : p.spawn_min.x, c & 2 ? p.spawn_max.y : p.spawn_min.y,
+                        c & 4 ? p.spawn_max.z : p.spawn_min.z};
+      top_spawn_height_ = std::max(top_spawn_height_, dot(corner, up_));
+    }
+  }
+  for (std::size_t f = 0; f < scene.fixtures.size(); ++f) {
+    const FeederLaw& law = scene.fixtures[f].law;
+    if (law.kind != FeederLaw::Kind::None) feeders_.push_back(static_cast<int>(f));
+    std::vector<Footprint> boxes;
+    for (const Fixture::Geom& geom : scene.fixtures[f].geoms) {
+      Footprint fp{geomBounds(geom), 0};
+      if (law.kind == FeederLaw::Kind::Vibration && !isEmpty(fp.box)) {
+        const Vibration& v = law.vibration;
+        fp.reach = std::abs(v.amplitude) +
+                   std::abs(v.torsion_amplitude) * farthest(fp.box, v.axis_origin);
+      }
+      boxes.push_back(fp);
+    }
+    footprints_.push_back(boxes);
+  }
   if (!isFullVibration(method)) part_efficiency_ = partEfficiencies(scene);
 }
 
@@ -307,8 +369,9 @@ PartSimulation::~PartSimulation() {
   if (ray_) dGeomDestroy(ray_);
 }
 
-void PartSimulation::addFixtureGeom(dGeomID geom) {
+void PartSimulation::addFixtureGeom(dGeomID geom, int fixture) {
   if (fixture_set_.insert(geom).second) fixture_geoms_.push_back(geom);
+  fixture_of_geom_[geom] = fixture;
 }
 
 void PartSimulation::ignoreSetting(const std::string& message) {
@@ -523,6 +586,7 @@ void PartSimulation::step() {
     }
     health_.local_law = sum;
   }
+  noteContacts();
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
     Track& tr = tracks_[i];
     if (!tr.active) continue;
@@ -538,11 +602,17 @@ void PartSimulation::step() {
       remove(i, check, s, s);
       continue;
     }
+    checkPhysicalSpeed(i, s);
     tr.beyond_exit = tr.beyond_exit || beyondExitPlane(scene_.outputs, s.position);
     if (!tr.counted && !tr.beyond_exit &&
         (tr.inside ||
          norm(s.position - tr.last.position) > kTunnelCheckFraction * tr.min_half_size)) {
       trackCrossings(i, tr.last.position, s);
+    }
+    std::string where;
+    if (!tr.counted && !tr.beyond_exit && leftFeeder(i, s, where)) {
+      countLoss(i, "part that left the feeder", "left the feeder " + where + " (kept)",
+                health_.parts_left_feeder, s);
     }
     if (check != PartCheck::Ok) {
       remove(i, check, s, s);

@@ -6,12 +6,19 @@
 
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
 #include <vector>
 
 #include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
+
+/// A contact of a part with a fixture geom in the last step (RunHealth, "Left the feeder").
+struct FixtureContact {
+  dGeomID part = nullptr, fixture = nullptr;
+  Vec3 normal_on_part;  ///< unit contact normal pushing the part (world)
+};
 
 /// What the ODE and the reference simulations share: the parts drawn from the scene, spawning
 /// them when due, the checks after each step that take out and count lost parts (RunHealth),
@@ -45,10 +52,15 @@ class PartSimulation : public Simulation {
   virtual void removePart(int index, const PartState& last) = 0;
   /// Impulses from fixtures on parts during the last step of h seconds.
   virtual ContactTotals fixtureImpulses(double h) const = 0;
+  /// The contacts of parts with fixtures in the last step (either geom order).
+  virtual std::vector<FixtureContact> fixtureContacts() const = 0;
   /// Whether `geom` belongs to a fixture (for fixtureImpulses).
   bool isFixture(dGeomID geom) const { return fixture_set_.count(geom) != 0; }
-  /// Registers a fixture geom (placed at its rest pose) for isFixture and the tunnelling test.
-  void addFixtureGeom(dGeomID geom);
+  /// Registers a geom (placed at its rest pose) of fixture `fixture` (index in Scene::fixtures)
+  /// for isFixture, the tunnelling test and the feeder contacts.
+  void addFixtureGeom(dGeomID geom, int fixture);
+  /// Registers the geom of part `index` (for fixtureContacts).
+  void addPartGeom(dGeomID geom, int index) { part_of_geom_[geom] = index; }
   /// Lists a setting the engine ignores (health_.ignored_settings) and prints it on stderr.
   void ignoreSetting(const std::string& message);
   /// Prints one line on stderr the first time `kind` (a short name) is seen in this run.
@@ -81,7 +93,24 @@ class PartSimulation : public Simulation {
     bool inside = false;
     Vec3 entry_point, entry_normal;
     Vec3 outside_point;  // the last centre outside before it went in (m)
+    // Left the feeder (RunHealth): touched a feeder; fixtures that supported it before that;
+    // a fixture not among its carriers supported it in the last step.
+    bool on_feeder = false;
+    std::vector<int> carriers;
+    int stranger = -1;
   };
+  // A fixture geom's footprint box at rest (empty: none, a plane or a mesh not loaded) and its
+  // vibration reach (m).
+  struct Footprint {
+    Bounds box;
+    double reach = 0;
+  };
+  // Records feeder contacts and supports of the last step (Track::on_feeder, carriers, stranger).
+  void noteContacts();
+  // Whether part i has left the feeder (RunHealth rule); `where` receives how.
+  bool leftFeeder(std::size_t i, const PartState& s, std::string& where) const;
+  // The physical speed check of part i in state s (counts and reports; keeps it).
+  void checkPhysicalSpeed(std::size_t i, const PartState& s);
   // Distance (m) from a along the segment a -> b to the first fixture surface it crosses
   // (ODE ray test at the geoms' current poses); infinity when it crosses none. `normal`
   // (optional) receives the surface normal there (unit, either orientation).
@@ -108,12 +137,20 @@ class PartSimulation : public Simulation {
   std::vector<Track> tracks_;
   std::unordered_set<dGeomID> fixture_set_;  // lookups only: never iterated
   std::vector<dGeomID> fixture_geoms_;       // in creation order (deterministic iteration)
+  std::unordered_map<dGeomID, int> fixture_of_geom_, part_of_geom_;  // lookups only
+  std::vector<std::vector<Footprint>> footprints_;  // per fixture, per geom
+  std::vector<int> feeders_;                        // fixtures with a law
+  Vec3 up_{0, 0, 1};                                // -gravity, unit
+  double top_spawn_height_ = 0;  // the highest spawn point along up_ (m; physical speed bound)
   dGeomID ray_ = nullptr;                    // for firstCrossing, in no space
   std::vector<std::string> reported_;        // kinds already reported on stderr
   double time_ = 0;
   long steps_ = 0;
   ContactTotals totals_;
 };
+
+/// "(x, y, z) m" with 6 significant digits (stderr reports).
+std::string formatPosition(const Vec3& x);
 
 /// Axis-aligned bounding box (m, world) of a fixture geom at its pose; empty (min > max) for a
 /// plane or a mesh that is not loaded. Shared by the scene limits and the scene check.

@@ -38,6 +38,7 @@ struct DriftSample {
   int exited = 0;            ///< parts that have crossed the exit plane so far
   /// Parts lost so far, by kind (RunHealth, cumulative at `time`).
   int fell = 0, through_fixture = 0, out_of_bounds = 0, nonfinite = 0, too_fast = 0;
+  int left_feeder = 0;  ///< RunHealth::parts_left_feeder
 };
 
 /// Exit orientation bins: the body axis that points most nearly up, with its sign.

@@ -37,23 +37,58 @@ struct ContactTotals {
 /// measureRun prints the totals and writes them into the run's JSON and CSV outputs.
 ///
 /// Each part is counted at most once, under the first of these that happened to it (checked
-/// after every step in the order non-finite, too fast, through a fixture, below the removal
-/// height or beyond the bounds), so partsLost() is a number of parts. A part that goes below
-/// Scene::removal_height or beyond the scene bounds after it was beyond the exit plane
-/// (Outputs::exit_plane, beyondExitPlane) is an exit, not a loss.
+/// after every step in the order non-finite, too fast, through a fixture, left the feeder,
+/// below the removal height or beyond the bounds), so partsLost() is a number of parts. A part
+/// that goes below Scene::removal_height or beyond the scene bounds after it was beyond the exit
+/// plane (Outputs::exit_plane, beyondExitPlane) is an exit, not a loss.
+///
+/// ## Left the feeder (issue 20)
+/// The feeders are the fixtures with a law (FeederLaw::Kind != None). A part's carriers are
+/// every feeder plus each fixture that supported it before it first touched a feeder (a hopper
+/// floor, an inlet chute). A fixture supports a part when one of their contacts has a normal
+/// on the part within 60 degrees of "up" (-gravity; kSupportCosine); a feeder carries a part in
+/// any contact. From its first contact with a feeder on, a part that is not beyond the exit
+/// plane has left the feeder when
+///   (a) the line through its centre along gravity misses the bounding box (at rest, world
+///       axes) of every geom of its carriers, each grown by kFootprintRadii bounding radii of
+///       the part plus the geom's vibration reach (A + theta R): it is beyond the feeder's
+///       footprint, in the air or on a catch floor, having gone over a wall, a rim or a side;
+///   (b) or a fixture that is not one of its carriers supports it while its centre is below the
+///       bottom of every carrier geom whose grown box that line meets: it fell under the feeder
+///       (through a gap) onto a floor.
+/// A carrier that is a plane, or a mesh that is not loaded, has no footprint (it covers every
+/// line). The part is counted (parts_left_feeder), reported with where it crossed, and kept.
+/// Parts that never touch a feeder are not followed (a scene without feeders never counts).
+///
+/// ## Too fast (issue 20)
+/// Each part is checked against its own physical speed bound (partPhysicalSpeedBound): its
+/// speed with the kinetic energy in translation, sqrt(|v|^2 + w.I w / m), may not exceed
+///   kPhysicalSpeedFactor [(1 + e) (|v0| + sqrt(2 |g| max(0, z0 - z))) + (1 + e) V + v_c]
+///   + kPhysicalSpeedMargin
+/// with |v0| the fastest initial speed of the scene, z0 its highest spawn point (a part may be
+/// hit by one that fell from there) and z the part's height now (along -gravity), V
+/// the fastest feeder surface point (SceneLimits::surface_speed: belt speed, drift, vibration
+/// peak velocity), e the restitution and v_c the push-out speed cap
+/// (SolverSettings::max_correcting_velocity). A part above it is counted as too fast and kept;
+/// a part above the scene's blow-up bound SceneLimits::speed_bound is also removed.
 struct RunHealth {
   long steps = 0;  ///< steps taken
   /// Parts removed below Scene::removal_height (or beyond the scene bounds) after being beyond
   /// the exit plane: normal flow.
   int parts_exited = 0;
-  /// Parts removed below Scene::removal_height without having been beyond the exit plane (fell
-  /// off an edge, or over a wall or rim).
+  /// Parts removed below Scene::removal_height without having been beyond the exit plane and
+  /// without having been counted as having left the feeder first (a part that never touched a
+  /// feeder and fell off an edge).
   int parts_fell = 0;
   /// Parts whose centre passed through a fixture (tunnelling: through a floor or a wall): within
   /// one step, or into it and out on another side, or into it and then out of the scene. They
   /// stay in the simulation until they leave it; each part is counted once. Parts beyond the
   /// exit plane are not checked (they are out of the measurement).
   int parts_through_fixture = 0;
+  /// Parts that left the feeder without crossing the exit plane: over a wall, a rim or a side,
+  /// onto a catch floor or into the air beyond the feeder's footprint (rule above). Kept in
+  /// the simulation; counted once.
+  int parts_left_feeder = 0;
   /// Parts whose centre went into a fixture (a penetration deeper than half the part) and came
   /// back out on the side it entered: not lost, but the contact did not hold them. Counted once
   /// per part; not part of partsLost().
@@ -67,8 +102,8 @@ struct RunHealth {
   /// Parts whose state (position, velocity, angular velocity, orientation) became NaN or
   /// infinite; they are removed at once.
   int parts_nonfinite = 0;
-  /// Parts that went faster than the scene's speed bound (SceneLimits::speed_bound: an energy
-  /// blow-up); counted once each, then removed.
+  /// Parts faster than their physical speed bound (rule above; kept), or than the scene's
+  /// blow-up bound SceneLimits::speed_bound (an energy blow-up; removed); counted once each.
   int parts_too_fast = 0;
   /// Reference engine: steps whose true-Coulomb fixed point did not settle and that used the
   /// fallback (0 for ODE), and steps with contacts whose contact solve did not converge
@@ -89,6 +124,9 @@ struct RunHealth {
   /// SceneLimits::speed_bound).
   double max_part_speed = 0;
   double speed_bound = 0;
+  /// Highest ratio of a part's energy speed to its physical speed bound seen after any step
+  /// (dimensionless; above 1 the part was counted too fast).
+  double max_speed_ratio = 0;
   /// Rheonomic runs: feeders driven by the local vibration law (DriftModel local or
   /// local_sampled; 0 when none), and that law's counts summed over them since the start
   /// (MotionLaw::localStats): contacts driven, of which walls (the horizontal surface's drift
@@ -99,11 +137,11 @@ struct RunHealth {
   /// The friction law the engine solved ("cone" or "pyramid"; odeFrictionModel for ODE, the
   /// reference engine always "cone"). Recorded in the run JSON.
   std::string friction_model;
-  /// Parts lost in any way but the exit: fell + through_fixture + out_of_bounds + nonfinite +
-  /// too_fast, plus those inside a fixture now.
+  /// Parts lost in any way but the exit: fell + through_fixture + left_feeder + out_of_bounds +
+  /// nonfinite + too_fast, plus those inside a fixture now.
   int partsLost() const {
-    return parts_fell + parts_through_fixture + parts_out_of_bounds + parts_nonfinite +
-           parts_too_fast + parts_inside_fixture;
+    return parts_fell + parts_through_fixture + parts_left_feeder + parts_out_of_bounds +
+           parts_nonfinite + parts_too_fast + parts_inside_fixture;
   }
   /// Whether anything was lost, not trusted or ignored.
   bool anything() const {
@@ -145,6 +183,27 @@ struct SceneLimits {
 constexpr double kSpeedBoundFactor = 2.0;
 constexpr double kSpeedBoundMargin = 1.0;
 
+/// Factor and margin (m/s) of a part's physical speed bound over its case's physics
+/// (RunHealth, "Too fast"; partPhysicalSpeedBound).
+constexpr double kPhysicalSpeedFactor = 1.25;
+constexpr double kPhysicalSpeedMargin = 0.1;
+/// A contact supports a part when its normal on the part is within 60 degrees of up (cosine).
+constexpr double kSupportCosine = 0.5;
+/// The footprint of a carrier geom: its box grown by this many bounding radii of the part
+/// (one: the farthest its centre can be while touching it; one more for hops at an edge).
+constexpr double kFootprintRadii = 2.0;
+
+/// The physical speed bound (m/s) of a part now at height `height` (m, along -gravity) in a
+/// scene with limits `limits`, restitution `restitution`, gravity `g` (m/s^2), fastest initial
+/// speed `initial_speed` (m/s) and highest spawn point `spawn_height` (m, along -gravity):
+/// RunHealth, "Too fast".
+double partPhysicalSpeedBound(const SceneLimits& limits, double restitution, double g,
+                              double initial_speed, double spawn_height, double height);
+/// The speed (m/s) of a part of mass `mass` (kg) and body-frame inertia `inertia` (kg m^2,
+/// row-major 3x3) whose kinetic energy is all in translation: sqrt(|v|^2 + w.I w / m), w the
+/// state's angular velocity turned into the body frame.
+double energySpeed(const PartState& state, double mass, const double inertia[9]);
+
 /// The limits of `scene` (SI units, world frame). Does not validate the scene.
 SceneLimits sceneLimits(const Scene& scene);
 
@@ -166,7 +225,8 @@ const char* toString(PartCheck check);
 /// radius about the centre of mass.
 double partSpeed(const PartState& state, double radius);
 /// Classifies a part's state after a step; `radius` (m) is its bounding radius (partSpeed).
-/// Tunnelling needs the geometry and is checked by the simulation itself.
+/// Tunnelling, the physical speed bound and leaving the feeder need the part's history and the
+/// geometry and are checked by the simulation itself.
 PartCheck checkPartState(const PartState& state, const SceneLimits& limits, double radius);
 
 class Simulation {
@@ -175,8 +235,8 @@ class Simulation {
   /// Advance one time step of scene.solver.time_step (s), spawning the parts that are due. After
   /// the step every active part is checked (RunHealth): a part with a non-finite state, faster
   /// than the scene's speed bound, below Scene::removal_height or beyond the scene bounds is
-  /// taken out of the simulation and counted; a part whose centre crossed a fixture surface is
-  /// counted and kept. Nothing is thrown for a bad state: the first part of each kind is named
+  /// taken out of the simulation and counted; a part whose centre crossed a fixture surface,
+  /// that left the feeder or that is faster than its physical bound is counted and kept. Nothing is thrown for a bad state: the first part of each kind is named
   /// on stderr, the counts are in health().
   virtual void step() = 0;
   /// Simulated time (s).

@@ -1,0 +1,255 @@
+// SPDX-License-Identifier: MIT
+// Geometry and part measures of the scene check (check_internal.hpp): bounding boxes, heights
+// along up, thicknesses, part size ranges, plan overlaps, spawn regions against fixtures.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "check_internal.hpp"
+#include "rheofeed/scene/mesh.hpp"
+#include "simulation_internal.hpp"
+
+namespace rheofeed::scene::checks {
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+std::string mm(double metres) {
+  return fmt(1000 * metres) + " mm";
+}
+std::string idx(const char* base, std::size_t i) {
+  return base + ("[" + std::to_string(i) + "]");
+}
+std::string geomPath(std::size_t f, std::size_t g) {
+  return idx("fixtures", f) + "." + idx("geoms", g);
+}
+
+
+// Bounding box of a fixture geom at its pose (the scene limits' computation); a plane or a mesh
+// not loaded is unbounded.
+Box3 geomBounds(const Fixture::Geom& g) {
+  const Bounds bounds = fixtureGeomBounds(g);
+  Box3 b;
+  if (bounds.min.x > bounds.max.x) {
+    b.bounded = false;
+  } else {
+    b.add(bounds.min);
+    b.add(bounds.max);
+  }
+  return b;
+}
+
+// Heights along `up` of a box's extremes.
+double maxAlong(const Box3& b, const Vec3& up) {
+  return std::max(b.lo.x * up.x, b.hi.x * up.x) + std::max(b.lo.y * up.y, b.hi.y * up.y) +
+         std::max(b.lo.z * up.z, b.hi.z * up.z);
+}
+double minAlong(const Box3& b, const Vec3& up) {
+  return -maxAlong(b, -up);
+}
+
+
+// Smallest extent of a mesh's bounding box in its own frame, times `scale` (m).
+double meshBoxExtent(const TriangleMesh& mesh, double scale) {
+  Box3 b;
+  for (std::size_t k = 0; k + 2 < mesh.vertices.size(); k += 3) {
+    b.add({mesh.vertices[k], mesh.vertices[k + 1], mesh.vertices[k + 2]});
+  }
+  const Vec3 e = b.hi - b.lo;
+  return scale * std::min({e.x, e.y, e.z});
+}
+
+// Thickness of a fixture geom (m): the smallest distance across it. Planes are half-spaces.
+Thickness fixtureThickness(const Shape& s) {
+  switch (s.kind) {
+    case Shape::Kind::Box:
+      return {std::min({s.size.x, s.size.y, s.size.z}), ""};
+    case Shape::Kind::Sphere:
+    case Shape::Kind::Capsule:
+      return {2 * s.radius, ""};
+    case Shape::Kind::Cylinder:
+      return {std::min(2 * s.radius, s.length), ""};
+    case Shape::Kind::Plane:
+      return {kInf, ""};
+    case Shape::Kind::Mesh: {
+      if (!s.mesh_data) return {0, " (mesh not loaded: counted as a surface of no thickness)"};
+      const MeshWallThickness wall = meshWallThickness(*s.mesh_data, 1.0);
+      if (!wall.measured) {
+        return {kInf, " (mesh wall not measured: skipped)", false, wall.ray_tests};
+      }
+      return {wall.thickness,
+              " (mesh wall: 5 % of its area is thinner, by ray casting; a crude estimate)"};
+    }
+  }
+  return {};
+}
+
+// Range of a size distribution that drawParts can return (m).
+double sizeLow(const Distribution& d) {
+  return d.stddev > 0 ? std::max({d.min, d.mean - kSigmas * d.stddev, 1e-3 * d.mean}) : d.mean;
+}
+double sizeHigh(const Distribution& d) {
+  return d.stddev > 0 ? std::min(d.max, d.mean + kSigmas * d.stddev) : d.mean;
+}
+
+// Mass (kg) and smallest thickness (m) of a part of family `p` with sizes `sz`.
+PartExtreme partExtreme(const PartSpec& p, const double sz[3], std::string* note) {
+  const double rho = p.density;
+  switch (p.shape) {
+    case Shape::Kind::Box:
+      return {rho * sz[0] * sz[1] * sz[2], std::min({sz[0], sz[1], sz[2]}),
+              std::max({sz[0], sz[1], sz[2]})};
+    case Shape::Kind::Sphere:
+      return {rho * 4.0 / 3.0 * kPi * std::pow(sz[0], 3), 2 * sz[0], 2 * sz[0]};
+    case Shape::Kind::Cylinder:
+      return {rho * kPi * sz[0] * sz[0] * sz[1], std::min(2 * sz[0], sz[1]),
+              std::max(2 * sz[0], sz[1])};
+    case Shape::Kind::Capsule:
+      return {rho * kPi * sz[0] * sz[0] * (sz[1] + 4.0 / 3.0 * sz[0]), 2 * sz[0],
+              sz[1] + 2 * sz[0]};
+    case Shape::Kind::Mesh: {
+      if (!p.mesh_data) {
+        if (note) *note = " (mesh part not loaded: its mass and thickness are unknown)";
+        return {0, 0, 0};
+      }
+      if (note) *note = " (mesh part: smallest bounding-box extent, an upper bound)";
+      const double extent = meshBoxExtent(*p.mesh_data, sz[0]);
+      return {massProperties(*p.mesh_data, rho).mass * std::pow(sz[0], 3), extent, extent};
+    }
+    case Shape::Kind::Plane:
+      break;
+  }
+  return {};
+}
+
+PartRange partRange(const PartSpec& p) {
+  const int n = partSizeCount(p.shape);
+  double lo[3], hi[3];
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = d < n ? sizeLow(p.size[d]) : 0;
+    hi[d] = d < n ? sizeHigh(p.size[d]) : 0;
+  }
+  PartRange r;
+  r.light = partExtreme(p, lo, &r.note);
+  r.heavy = partExtreme(p, hi, nullptr);
+  // The thinnest part: every size at its low end but a cylinder's length (min(2r, L)) is
+  // also lowest there, so the light part is the thinnest.
+  r.thinnest = r.light.thickness;
+  return r;
+}
+
+// 2D overlap area test of two upright boxes projected on the plane normal to `up`
+// (separating axes: the boxes' in-plane edges).
+bool planOverlap(const Fixture::Geom& a, const Fixture::Geom& b, const Vec3& up) {
+  auto axes = [&](const Fixture::Geom& g, Vec3 out[3], double half[3]) {
+    const double* r = g.pose.rotation;
+    const double size[3] = {g.shape.size.x, g.shape.size.y, g.shape.size.z};
+    for (int c = 0; c < 3; ++c) {
+      out[c] = {r[c], r[3 + c], r[6 + c]};
+      half[c] = 0.5 * size[c];
+    }
+  };
+  Vec3 ax[3], bx[3];
+  double ah[3], bh[3];
+  axes(a, ax, ah);
+  axes(b, bx, bh);
+  auto radius = [&](const Vec3 e[3], const double h[3], const Vec3& dir) {
+    double s = 0;
+    for (int c = 0; c < 3; ++c) {
+      if (std::abs(dot(e[c], up)) < kUprightCosine) s += h[c] * std::abs(dot(e[c], dir));
+    }
+    return s;
+  };
+  const Vec3 d = b.pose.position - a.pose.position;
+  for (const Vec3* set : {ax, bx}) {
+    for (int c = 0; c < 3; ++c) {
+      if (std::abs(dot(set[c], up)) >= kUprightCosine) continue;
+      const double gap = std::abs(dot(d, set[c])) - radius(ax, ah, set[c]) - radius(bx, bh, set[c]);
+      if (gap >= -kSeamTolerance) return false;  // touching edges are no overlap
+    }
+  }
+  return true;
+}
+
+bool upright(const Fixture::Geom& g, const Vec3& up) {
+  if (g.shape.kind != Shape::Kind::Box) return false;
+  const double* r = g.pose.rotation;
+  for (int c = 0; c < 3; ++c) {
+    if (std::abs(r[c] * up.x + r[3 + c] * up.y + r[6 + c] * up.z) >= kUprightCosine) return true;
+  }
+  return false;
+}
+
+// Whether the axis-aligned region [lo, hi] (world) reaches into a fixture geom.
+bool regionInsideGeom(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g) {
+  const Shape& s = g.shape;
+  if (s.kind == Shape::Kind::Plane) {
+    double lowest = kInf;  // the region's corner deepest below the plane
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 p{c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z};
+      lowest = std::min(lowest, dot(s.plane_normal, p) - s.plane_offset);
+    }
+    return lowest < 0;
+  }
+  if (s.kind == Shape::Kind::Mesh) return false;  // hollow in general: not checked
+  if (s.kind == Shape::Kind::Sphere) {
+    const Vec3 c = g.pose.position;
+    const Vec3 nearest{std::clamp(c.x, lo.x, hi.x), std::clamp(c.y, lo.y, hi.y),
+                       std::clamp(c.z, lo.z, hi.z)};
+    return norm(nearest - c) < s.radius;
+  }
+  const Box3 b = geomBounds(g);
+  const bool aabb = lo.x < b.hi.x && hi.x > b.lo.x && lo.y < b.hi.y && hi.y > b.lo.y &&
+                    lo.z < b.hi.z && hi.z > b.lo.z;
+  if (!aabb || s.kind != Shape::Kind::Box) return aabb;  // cylinder, capsule: bounding box
+  // Box: separating axes of two boxes (the region's 3, the geom's 3, their 9 cross products).
+  const double* r = g.pose.rotation;
+  const Vec3 ge[3] = {{r[0], r[3], r[6]}, {r[1], r[4], r[7]}, {r[2], r[5], r[8]}};
+  const double gh[3] = {0.5 * s.size.x, 0.5 * s.size.y, 0.5 * s.size.z};
+  const Vec3 re[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const double rh[3] = {0.5 * (hi.x - lo.x), 0.5 * (hi.y - lo.y), 0.5 * (hi.z - lo.z)};
+  const Vec3 d = g.pose.position - 0.5 * (lo + hi);
+  auto separated = [&](const Vec3& axis) {
+    if (!(norm(axis) > 1e-12)) return false;
+    double ra = 0, rb = 0;
+    for (int c = 0; c < 3; ++c) {
+      ra += rh[c] * std::abs(dot(re[c], axis));
+      rb += gh[c] * std::abs(dot(ge[c], axis));
+    }
+    return std::abs(dot(d, axis)) >= ra + rb;
+  };
+  for (int i = 0; i < 3; ++i) {
+    if (separated(re[i]) || separated(ge[i])) return false;
+    for (int j = 0; j < 3; ++j) {
+      if (separated(cross(re[i], ge[j]))) return false;
+    }
+  }
+  return true;
+}
+
+// Largest surface speed of a drift twist over a box (m/s): |v + w x (c - O)| is convex in c,
+// so its maximum over the box is at a corner.
+double twistSpeedOver(const Twist& t, const Box3& b) {
+  double fastest = norm(t.linear);
+  if (!b.bounded) return isZero(t.angular) ? fastest : kInf;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 p{c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z};
+    fastest = std::max(fastest, norm(t.linear + cross(t.angular, p - t.origin)));
+  }
+  return fastest;
+}
+
+// Largest distance of a box's corners from an axis (m).
+double radiusFromAxis(const Box3& b, const Vec3& origin, const Vec3& axis) {
+  double r = 0;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 p{c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z};
+    r = std::max(r, norm(cross(axis, p - origin)));
+  }
+  return r;
+}
+
+
+}  // namespace rheofeed::scene::checks
