@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/scene/mesh.hpp"
 #include "scene_limits.hpp"
 
@@ -27,7 +28,6 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 using ojson = nlohmann::ordered_json;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kFormatVersion = 1;
 
 [[noreturn]] void fail(const std::string& path, const std::string& problem) {
@@ -42,10 +42,7 @@ std::string describe(const json& v) {
 }
 
 std::string show(double v) {
-  std::ostringstream out;
-  out.precision(10);
-  out << v;
-  return out.str();
+  return formatNumber(v, 10);
 }
 
 // ---- Text to DOM -------------------------------------------------------------------------------

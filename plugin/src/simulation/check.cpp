@@ -9,6 +9,7 @@
 #include <limits>
 #include <sstream>
 
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/scene/mesh.hpp"
 #include "rheofeed/scene/run_step.hpp"
 #include "simulation_internal.hpp"
@@ -16,7 +17,6 @@
 namespace rheofeed::scene {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // A size distribution is taken to reach mean +- 5 standard deviations (within min/max): a
 // draw lies beyond with probability 5.7e-7, once in 580 scenes of 1000 boxes.
@@ -27,9 +27,7 @@ constexpr double kSeamTolerance = 1e-6;
 constexpr double kUprightCosine = 1 - 1e-9;
 
 std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
+  return formatNumber(v, 3);
 }
 std::string mm(double metres) {
   return fmt(1000 * metres) + " mm";
