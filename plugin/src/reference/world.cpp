@@ -15,6 +15,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "ode_vec.hpp"
 #include "rheofeed/ccp/problem.hpp"
 
 namespace rheofeed::reference {
@@ -228,13 +229,7 @@ struct World::Impl {
       const Matrix3d rb = rotation(a.body);
       const Matrix3d r = rb * rotationOf(a.offset);
       const Vector3d x = toEigen(body.state.position) + rb * toEigen(a.offset.position);
-      dGeomSetPosition(geom, x.x(), x.y(), x.z());
-      dMatrix3 m;
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) m[4 * i + j] = r(i, j);
-        m[4 * i + 3] = 0;
-      }
-      dGeomSetRotation(geom, m);
+      setGeomPose(geom, poseOf(x, r));
     }
   }
 
