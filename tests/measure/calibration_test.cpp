@@ -18,11 +18,11 @@
 namespace rheofeed::scene {
 namespace {
 
-constexpr double kG = 9.81;                 // m/s^2
-constexpr double kBeta = kPi / 6;           // vibration angle above the track, 30 degrees
-constexpr double kThrowNumber = 3.4;        // Gamma = A w^2 sin(beta) / g
-constexpr double kFrequency = 50;           // Hz
-const double kW = 2 * kPi * kFrequency;     // rad/s
+constexpr double kG = 9.81;              // m/s^2
+constexpr double kBeta = kPi / 6;        // vibration angle above the track, 30 degrees
+constexpr double kThrowNumber = 3.4;     // Gamma = A w^2 sin(beta) / g
+constexpr double kFrequency = 50;        // Hz
+const double kW = 2 * kPi * kFrequency;  // rad/s
 const double kAmplitude = kThrowNumber * kG / (kW * kW * std::sin(kBeta));  // m
 // The model integrates the flight in closed form and finds the landing by root finding to
 // rounding: the closed form holds to 1e-9 relative (as in classical_model_test.cpp).

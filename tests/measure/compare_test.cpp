@@ -15,10 +15,10 @@
 namespace rheofeed::scene {
 namespace {
 
-constexpr double kG = 9.81;      // m/s^2
-constexpr double kEdge = 0.02;   // m, cube edge
-constexpr double kDensity = 1000;  // kg/m^3
-constexpr double kStep = 0.005;  // s
+constexpr double kG = 9.81;         // m/s^2
+constexpr double kEdge = 0.02;      // m, cube edge
+constexpr double kDensity = 1000;   // kg/m^3
+constexpr double kStep = 0.005;     // s
 constexpr double kBeltSpeed = 0.3;  // m/s
 // At rest the contact impulse balances the weight over a step; the iterative solves (ODE
 // quickstep and the reference PGS, 50 iterations) and the contact compliance (CFM 1e-5) leave

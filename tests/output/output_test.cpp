@@ -178,11 +178,11 @@ TEST(OrientationCsv, OneRowPerFamilyWithItsCountsAndHistogram) {
   EXPECT_EQ(rows[0], (std::vector<std::string>{"family", "shape", "spawned", "exited",
                                                "removed_without_exit", "orientation_meaningful",
                                                "+x", "-x", "+y", "-y", "+z", "-z"}));
-  EXPECT_EQ(rows[1], (std::vector<std::string>{"cubes", "box", "5", "2", "1", "true", "0", "0",
-                                               "0", "0", "2", "0"}));
+  EXPECT_EQ(rows[1], (std::vector<std::string>{"cubes", "box", "5", "2", "1", "true", "0", "0", "0",
+                                               "0", "2", "0"}));
   // The comma and the quotes survive the CSV quoting; the repeated name gets its index.
-  EXPECT_EQ(rows[2], (std::vector<std::string>{"nut, \"M6\"", "sphere", "3", "1", "0", "false",
-                                               "1", "0", "0", "0", "0", "0"}));
+  EXPECT_EQ(rows[2], (std::vector<std::string>{"nut, \"M6\"", "sphere", "3", "1", "0", "false", "1",
+                                               "0", "0", "0", "0", "0"}));
   EXPECT_EQ(rows[3][0], "cubes[2]");
   EXPECT_EQ(rows[3][2], "4");
 }

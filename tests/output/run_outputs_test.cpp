@@ -100,10 +100,10 @@ TEST(SeriesCsv, OneRowPerSampleReadsBackAsTheSeries) {
   const RunMetrics r = run();
   const auto rows = csvRows(seriesCsv(r));
   ASSERT_EQ(rows.size(), 3u);
-  EXPECT_EQ(rows[0], (std::vector<std::string>{
-                         "time_s", "parts", "mean_velocity_mps", "ci95_mps", "mean_height_m",
-                         "exited", "lost_fell", "lost_through_fixture", "lost_out_of_bounds",
-                         "lost_nonfinite", "lost_too_fast"}));
+  EXPECT_EQ(rows[0], (std::vector<std::string>{"time_s", "parts", "mean_velocity_mps", "ci95_mps",
+                                               "mean_height_m", "exited", "lost_fell",
+                                               "lost_through_fixture", "lost_out_of_bounds",
+                                               "lost_nonfinite", "lost_too_fast"}));
   for (std::size_t k = 0; k < r.series.size(); ++k) {
     const DriftSample& d = r.series[k];
     const auto& row = rows[k + 1];
@@ -113,8 +113,8 @@ TEST(SeriesCsv, OneRowPerSampleReadsBackAsTheSeries) {
     EXPECT_NEAR(std::stod(row[2]), d.mean_velocity, kEightDigits * std::abs(d.mean_velocity));
     EXPECT_NEAR(std::stod(row[3]), d.ci95, kEightDigits * d.ci95);
     EXPECT_NEAR(std::stod(row[4]), d.mean_height, kEightDigits * d.mean_height);
-    const int counts[] = {d.exited, d.fell, d.through_fixture, d.out_of_bounds, d.nonfinite,
-                          d.too_fast};
+    const int counts[] = {d.exited,        d.fell,      d.through_fixture,
+                          d.out_of_bounds, d.nonfinite, d.too_fast};
     for (int c = 0; c < 6; ++c) EXPECT_EQ(std::stoi(row[5 + c]), counts[c]) << "column " << 5 + c;
   }
 }
