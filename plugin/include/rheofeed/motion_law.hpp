@@ -314,4 +314,10 @@ class StepLaw {
   std::string problem_;
 };
 
+/// Angular velocity (rad/s, world frame) that turns `p0`'s rotation into `p1`'s in `h` seconds
+/// (h > 0): the axis-angle of `R1 R0^T` divided by h, the secant of a prescribed rotation, as a
+/// kinematic body's velocity over a step (ODE's kinematic bodies and the reference world). The
+/// positions of the poses are not used. An angle is taken in [0, pi]; zero rotation gives zero.
+Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h);
+
 }  // namespace rheofeed

@@ -170,7 +170,7 @@ class OdeSimulation final : public PartSimulation {
     dBodySetRotation(body, r);
     const Vec3 lin = (1.0 / h) * (p1.position - p0.position);
     dBodySetLinearVel(body, lin.x, lin.y, lin.z);
-    const Vec3 ang = reference::secantAngularVelocity(p0, p1, h);
+    const Vec3 ang = secantAngularVelocity(p0, p1, h);
     dBodySetAngularVel(body, ang.x, ang.y, ang.z);
   }
 

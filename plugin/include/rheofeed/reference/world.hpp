@@ -54,12 +54,21 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/ccp/problem.hpp"
-#include "rheofeed/ccp/solver.hpp"
+#include "rheofeed/ccp/settings.hpp"
 #include "rheofeed/motion_law.hpp"
 #include "rheofeed/vec3.hpp"
 
+namespace rheofeed::ccp {
+struct Problem;
+}
+
 namespace rheofeed::reference {
+
+struct WorldState;
+class World;
+
+/// The contact problem of `world`'s last step with contacts (contact_problem.hpp).
+const ccp::Problem& lastContactProblem(const World& world);
 
 /// Index of a body in a World (0, 1, ...). kStatic means "no body" (the static environment).
 using BodyId = int;
@@ -70,9 +79,6 @@ struct Quat {
   double w = 1, x = 0, y = 0, z = 0;
 };
 
-/// Angular velocity (rad/s, world) that turns p0's rotation into p1's in h seconds (the
-/// secant of a prescribed rotation, as given to kinematic bodies).
-Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h);
 /// The rotation of a pose as a unit quaternion, and back (row-major matrix, body to world).
 Quat toQuat(const Pose& pose);
 Pose toPose(const Quat& q, const Vec3& position = {});
@@ -210,12 +216,10 @@ class World {
   const std::vector<ContactImpulse>& contacts() const;
   /// Settings; changes apply from the next step.
   Settings& settings();
-  /// The contact problem of the last step with contacts (for benchmarks and inspection).
-  const ccp::Problem& lastProblem() const;
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  friend const ccp::Problem& lastContactProblem(const World& world);
+  std::unique_ptr<WorldState> impl_;  // world_internal.hpp
 };
 
 }  // namespace rheofeed::reference
