@@ -6,8 +6,6 @@
 namespace rheofeed::scene {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 Fixture boxFixture(const std::string& name, const Vec3& size, const Pose& pose) {
   Fixture f;
   f.name = name;

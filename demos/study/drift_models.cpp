@@ -23,7 +23,6 @@ namespace {
 
 using namespace rheofeed::scene;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180;
 
 // The drift models of the comparison, in table order.

@@ -34,10 +34,11 @@
 #include <vector>
 
 #include "ode_world.hpp"
-#include "rheofeed/motion_law.hpp"
 #include "rheofeed/measure/classical_model.hpp"
+#include "rheofeed/motion_law.hpp"
 #include "rheofeed/simulation/simulation.hpp"
 #include "rheofeed/vibration_drift.hpp"
+#include "scene_builders.hpp"
 
 namespace rheofeed {
 namespace {
@@ -45,7 +46,6 @@ namespace {
 using scene::ClassicalDrift;
 using scene::ClassicalParams;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180;
 constexpr double kG = 9.81;
 
@@ -477,13 +477,7 @@ scene::Scene fullVibrationScene(const PartOnFeeder& u, scene::Method method, int
   scene::Scene s;
   s.name = "local_law_" + u.name;
   s.gravity = u.gravity;
-  scene::Fixture track;
-  track.name = "track";
-  scene::Fixture::Geom g;
-  g.shape.kind = scene::Shape::Kind::Box;
-  g.shape.size = u.track_size;
-  g.pose.position = u.track_center - Vec3{0, 0, 0.5 * u.track_size.z};
-  track.geoms.push_back(g);
+  scene::Fixture track = test::boxFixture("track", u.track_size, u.track_center);
   track.law.kind = scene::FeederLaw::Kind::Vibration;
   scene::Vibration& v = track.law.vibration;
   v.frequency = u.frequency;

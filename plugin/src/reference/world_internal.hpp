@@ -19,6 +19,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "ode_vec.hpp"  // the ODE <-> rheofeed conversions (toVec3, setGeomPose)
 #include "rheofeed/ccp/problem.hpp"
 #include "rheofeed/ccp/solver.hpp"
 #include "rheofeed/reference/world.hpp"
@@ -35,9 +36,7 @@ inline Vector3d toEigen(const Vec3& v) {
 inline Vec3 toVec3(const Vector3d& v) {
   return {v.x(), v.y(), v.z()};
 }
-inline Vec3 toVec3(const dReal* a) {
-  return {a[0], a[1], a[2]};
-}
+using rheofeed::toVec3;  // of ODE's arrays (ode_vec.hpp)
 inline Eigen::Quaterniond toEigen(const Quat& q) {
   return {q.w, q.x, q.y, q.z};
 }
@@ -189,13 +188,7 @@ struct WorldState {
       const Matrix3d r = rb * detail::rotationOf(a.offset);
       const Vector3d x =
           detail::toEigen(body.state.position) + rb * detail::toEigen(a.offset.position);
-      dGeomSetPosition(geom, x.x(), x.y(), x.z());
-      dMatrix3 m;
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) m[4 * i + j] = r(i, j);
-        m[4 * i + 3] = 0;
-      }
-      dGeomSetRotation(geom, m);
+      setGeomPose(geom, detail::poseOf(x, r));
     }
   }
 

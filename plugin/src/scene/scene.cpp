@@ -10,13 +10,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/scene/mesh.hpp"
 #include "scene_limits.hpp"
 
 namespace rheofeed::scene {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Truncated normal sizes are redrawn this many times before the value is clamped.
 constexpr int kRedraws = 100;
 // Attempts to place a part spawned at t = 0 without overlapping earlier ones.
@@ -29,9 +29,7 @@ constexpr int kPlacementTries = 200;
 }
 
 std::string show(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
+  return formatNumber(v);
 }
 
 void positive(const std::string& path, double v) {

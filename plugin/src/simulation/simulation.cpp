@@ -66,7 +66,6 @@ namespace rheofeed::scene {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinMargin = 1.0;             // m: smallest margin around the scene's extent
 constexpr double kTunnelCheckFraction = 1e-3;  // of the smallest half-size, see above
 // Two crossings along one segment are distinct when they are this far apart (m): far below any
