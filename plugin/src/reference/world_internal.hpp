@@ -19,6 +19,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "rheofeed/ccp/nsgs.hpp"
 #include "rheofeed/ccp/problem.hpp"
 #include "rheofeed/ccp/solver.hpp"
 #include "rheofeed/reference/world.hpp"
@@ -121,7 +122,7 @@ struct WorldState {
     BodyId a, b;
     Vector3d p, n;
     double depth, mu;
-    int index;  // position among the pair's contacts (warm start key)
+    int index;  // position among the pair's contacts
   };
 
   Settings settings;
@@ -139,9 +140,17 @@ struct WorldState {
   std::unordered_map<dGeomID, std::size_t> feeder_index;
   FrictionCallback friction;
   ccp::Solver solver;
+  ccp::NsgsSolver nsgs;
   std::vector<RawContact> raw;
   std::vector<ContactImpulse> contacts;
-  std::map<std::tuple<dGeomID, dGeomID, int>, Vector3d> warm;
+  // Last step's contacts per geom pair (dCollide's order): point and impulse on g1's body, both
+  // world frame (the warm start).
+  struct WarmContact {
+    Vector3d position;
+    Vector3d impulse;
+  };
+  std::map<std::pair<dGeomID, dGeomID>, std::vector<WarmContact>> warm;
+  std::vector<char> warm_claimed;  // scratch of warmStartStage
   std::vector<dContactGeom> scratch;
   ccp::Problem problem;  // the last step's contact problem
 
