@@ -20,7 +20,7 @@
 
 #include "rheofeed/contact_collider.hpp"
 #include "rheofeed/feeder_set.hpp"
-#include "rheofeed/scene/output.hpp"
+#include "rheofeed/output/output.hpp"
 
 namespace {
 

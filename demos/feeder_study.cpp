@@ -14,7 +14,7 @@
 #include <string>
 
 #include "common/study.hpp"
-#include "rheofeed/scene/builtin_scenes.hpp"
+#include "common/builtin_scenes.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 #include "study/drift_models.hpp"
 

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/scene/builtin_scenes.hpp"
-#include "rheofeed/scene/compare.hpp"
-#include "rheofeed/scene/output.hpp"
+#include "common/builtin_scenes.hpp"
+#include "rheofeed/measure/compare.hpp"
+#include "rheofeed/output/output.hpp"
 
 namespace {
 

@@ -7,7 +7,7 @@
 #include <system_error>
 
 #include "cli/commands.hpp"
-#include "rheofeed/scene/output.hpp"
+#include "rheofeed/output/output.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 
 namespace rheofeed::cli {
@@ -72,7 +72,7 @@ int calibrateCommand(const CalibrateArgs& args) {
   return runChecked("rheofeed calibrate", [&] {
     Scene scene = plan.scene;
     CalibrateOptions options = args.calibrate;
-    options.rheonomic_time_step = sceneStep(scene, Method::OdeRheonomic, nullptr);
+    options.rheonomic_time_step = runStep(scene, Method::OdeRheonomic).time_step;
     const CalibrateReport report = calibrateScene(scene, options, "rheofeed calibrate", stderr);
     if (report.calibrated == 0 && report.given == 0) {
       throw std::invalid_argument(

@@ -4,7 +4,7 @@
 #include <exception>
 
 #include "cli/commands.hpp"
-#include "rheofeed/scene/check.hpp"
+#include "rheofeed/simulation/check.hpp"
 
 namespace rheofeed::cli {
 

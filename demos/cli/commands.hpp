@@ -8,10 +8,12 @@
 #include <functional>
 #include <string>
 
-#include "cli/calibrate_scene.hpp"
+#include "rheofeed/measure/calibration.hpp"
 #include "cli/run_plan.hpp"
 
 namespace rheofeed::cli {
+
+using rheofeed::scene::CalibrateOptions;
 
 /// `rheofeed run SCENE`: runs every method, writes <method>.csv/.json/.png, methods.png,
 /// mean_height.png and, with `animation`, <first method>.glb and view.html into `out`. Prints a

@@ -11,9 +11,11 @@
 #include <vector>
 
 #include "cli/commands.hpp"
-#include "rheofeed/scene/animation.hpp"
-#include "rheofeed/scene/metrics.hpp"
-#include "rheofeed/scene/plot.hpp"
+#include "rheofeed/output/animation.hpp"
+#include "rheofeed/output/output.hpp"
+#include "rheofeed/simulation/check.hpp"
+#include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/output/plot.hpp"
 
 namespace rheofeed::cli {
 
@@ -136,9 +138,11 @@ int runCommand(const RunArgs& args) {
                    number(s.duration).c_str());
       std::unique_ptr<AnimationRecorder> recorder;
       if (args.animation && k == 0) recorder = std::make_unique<AnimationRecorder>(s, m);
-      const RunMetrics r =
+      const std::vector<std::string> hazards = reportSceneCheck(s, m);
+      RunMetrics r =
           measureRun(s, m, lineProgress(std::string("rheofeed run: ") + toString(m), s.duration),
-                     recorder.get());
+                     {recorder.get()});
+      r.scene_check = hazards;
       writeRunOutputs(r, out.string(), toString(m));
       if (recorder) recorder->write(out / (toString(m) + std::string(".glb")));
       blocks.emplace_back(toString(m), seriesCsv(r));

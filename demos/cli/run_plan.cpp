@@ -8,7 +8,6 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "cli/calibrate_scene.hpp"
 #include "cli/commands.hpp"
 #include "cli/shipped_scenes.hpp"
 #include "rheofeed/scene/scene_io.hpp"
@@ -43,21 +42,22 @@ std::string methodNames() {
   return names;
 }
 
+DriftModel parseDriftModelOption(const std::string& name) {
+  DriftModel model = DriftModel::Local;
+  if (!parseDriftModel(name, model)) {
+    throw std::invalid_argument("--drift-model " + name +
+                                ": unknown drift model; valid drift models: local, "
+                                "local_sampled, calibrated_drift");
+  }
+  return model;
+}
+
 Method parseMethod(const std::string& name) {
   for (Method m : kMethods) {
     if (name == toString(m)) return m;
   }
   throw std::invalid_argument("--method " + name +
                               ": unknown method; valid methods: " + methodNames());
-}
-
-double sceneStep(const Scene& scene, Method method, std::string* source) {
-  if (!isFullVibration(method) && scene.solver.rheonomic_time_step > 0) {
-    if (source) *source = "the scene's solver.rheonomic_time_step";
-    return scene.solver.rheonomic_time_step;
-  }
-  if (source) *source = "the scene's solver.time_step";
-  return scene.solver.time_step;
 }
 
 Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_methods) {
@@ -75,8 +75,7 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
                                 " s: must be a finite number >= 0 s (and below the duration)");
   }
   if (!args.drift_model.empty()) {
-    Scene probe;  // the name is checked before the scene is read
-    overrideDriftModel(probe, args.drift_model);
+    (void)parseDriftModelOption(args.drift_model);  // checked before the scene is read
   }
 
   Plan plan;
@@ -87,7 +86,7 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
   if (args.duration_given) scene.duration = args.duration;
   if (args.warmup_given) scene.outputs.warmup = args.warmup;
   if (args.seed_given) scene.seed = args.seed;
-  if (!args.drift_model.empty()) overrideDriftModel(scene, args.drift_model);
+  if (!args.drift_model.empty()) overrideDriftModel(scene, parseDriftModelOption(args.drift_model));
   const std::string where =
       "scene " + plan.file.string() +
       (args.duration_given ? " with --duration " + number(args.duration) + " s" : std::string()) +
@@ -100,19 +99,12 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
   for (Method m : methods) {
     PlannedRun run;
     run.method = m;
-    run.scene = scene;
-    double h = sceneStep(scene, m, &run.step_source);
-    if (args.dt_given) {
-      h = args.dt;
-      run.step_source = "--dt";
-    }
-    run.scene.solver.time_step = h;
-    // This run's step is time_step now; rheonomic_time_step stays (equal to it) only when it is
-    // where the step came from, so that the scene check names the field to change.
-    const bool from_rheonomic_field =
-        !args.dt_given && !isFullVibration(m) && scene.solver.rheonomic_time_step > 0;
-    run.scene.solver.rheonomic_time_step = from_rheonomic_field ? h : 0;
-    run.scene.outputs.sample_interval = std::max(run.scene.outputs.sample_interval, h);
+    StepOverrides overrides;
+    if (args.dt_given) overrides.every_run = args.dt;
+    const RunStep step = runStep(scene, m, overrides);
+    const double h = step.time_step;
+    run.step_source = step.source();
+    run.scene = atRunStep(scene, step);
     try {
       run.scene.validate();
     } catch (const std::invalid_argument& e) {

@@ -3,12 +3,8 @@
 // command-line overrides (duration, seed, time step) and one scene per method with the time step
 // it takes. Every input is checked here, before anything runs or calibrates.
 //
-// The time step rule (the same for `run`, `check` and `calibrate`):
-//   --dt given           every run takes --dt, rheonomic and full-vibration alike;
-//   rheonomic run        the scene's solver.rheonomic_time_step when it gives one (> 0), else
-//                        its solver.time_step;
-//   full-vibration run   the scene's solver.time_step.
-// Every run prints its step and which of these it came from.
+// The time step of each run follows the library's rule (rheofeed/scene/run_step.hpp, --dt as its
+// override); every run prints its step and where it came from.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "rheofeed/scene/run_step.hpp"
 #include "rheofeed/scene/scene.hpp"
 
 namespace rheofeed::cli {
@@ -33,7 +30,7 @@ struct SceneArgs {
   std::uint64_t seed = 0;  ///< --seed, when seed_given
   bool seed_given = false;
   /// --drift-model: empty keeps each vibrating feeder's drift model; else local, local_sampled
-  /// or calibrated_drift for all of them (overrideDriftModel, calibrate_scene.hpp).
+  /// or calibrated_drift for all of them (overrideDriftModel, scene.hpp).
   std::string drift_model;
 };
 
@@ -56,12 +53,12 @@ struct Plan {
 /// The names of the four methods, comma-separated ("ode_rheonomic, ode_full_vibration, ...").
 std::string methodNames();
 
+/// The drift model named `name` (--drift-model); throws std::invalid_argument naming
+/// --drift-model and the valid names for another name.
+rheofeed::scene::DriftModel parseDriftModelOption(const std::string& name);
+
 /// The method named `name`; throws std::invalid_argument listing the valid names.
 rheofeed::scene::Method parseMethod(const std::string& name);
-
-/// The time step (s) a run of `method` takes in `scene` without --dt, and where it comes from.
-double sceneStep(const rheofeed::scene::Scene& scene, rheofeed::scene::Method method,
-                 std::string* source);
 
 /// Checks the overrides, loads the scene and builds every run (the step rule above; the sample
 /// interval is raised to the step where it is shorter). `default_methods` are used when

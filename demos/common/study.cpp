@@ -10,11 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/scene/builtin_scenes.hpp"
-#include "rheofeed/scene/calibration.hpp"
-#include "rheofeed/scene/metrics.hpp"
-#include "rheofeed/scene/output.hpp"
-#include "rheofeed/scene/plot.hpp"
+#include "common/builtin_scenes.hpp"
+#include "rheofeed/measure/calibration.hpp"
+#include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/measure/statistics.hpp"
+#include "rheofeed/output/output.hpp"
+#include "rheofeed/output/plot.hpp"
 
 namespace rheofeed::demo {
 
@@ -66,15 +67,8 @@ std::string runStudy(const Scene& scene, const StudyOptions& options) {
     ref_drifts.push_back(m.mean_drift);
     ref_cpu += m.cpu_seconds;
   }
-  double ref = 0;
-  for (double d : ref_drifts) ref += d;
-  ref /= options.seeds;
-  double ss = 0;
-  for (double d : ref_drifts) ss += (d - ref) * (d - ref);
-  const double ref_ci = options.seeds > 1
-                            ? studentT95(options.seeds - 1) * std::sqrt(ss / (options.seeds - 1)) /
-                                  std::sqrt(double(options.seeds))
-                            : 0;
+  const double ref = mean(ref_drifts);
+  const double ref_ci = ci95(ref_drifts);
   if (std::abs(ref) < 1e-9)
     throw std::runtime_error("the reference drift is zero: nothing to study");
   std::fprintf(stderr, "reference drift %.6g +- %.2g m/s (%d seeds, %d steps/cycle)\n", ref, ref_ci,

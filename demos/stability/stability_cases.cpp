@@ -10,9 +10,9 @@
 #include <limits>
 #include <stdexcept>
 
-#include "rheofeed/scene/builtin_scenes.hpp"
-#include "rheofeed/scene/calibration.hpp"
-#include "rheofeed/scene/classical_model.hpp"
+#include "common/builtin_scenes.hpp"
+#include "rheofeed/measure/calibration.hpp"
+#include "rheofeed/measure/classical_model.hpp"
 
 namespace rheofeed::stability {
 namespace {

@@ -39,7 +39,7 @@
 #include <vector>
 
 #include "rheofeed/scene/scene.hpp"
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::stability {
 

@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/scene/output.hpp"
+#include "rheofeed/output/output.hpp"
 #include "stability/stability_cases.hpp"
 
 namespace {

@@ -17,7 +17,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "rheofeed/scene/check.hpp"
+#include "rheofeed/simulation/check.hpp"
 #include "stability/stability_cases.hpp"
 
 namespace rheofeed::stability {

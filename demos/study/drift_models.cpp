@@ -10,11 +10,12 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "rheofeed/scene/builtin_scenes.hpp"
-#include "rheofeed/scene/calibration.hpp"
-#include "rheofeed/scene/metrics.hpp"
-#include "rheofeed/scene/output.hpp"
-#include "rheofeed/scene/plot.hpp"
+#include "common/builtin_scenes.hpp"
+#include "rheofeed/scene/run_step.hpp"
+#include "rheofeed/measure/calibration.hpp"
+#include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/output/output.hpp"
+#include "rheofeed/output/plot.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 
 namespace rheofeed::demo {
@@ -286,9 +287,9 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
       r.judge_steps_per_cycle = ref_spc;
       // The scene's own rheonomic step where it gives one (the bowl: 0.005 s, its trimesh
       // floor lets nuts tunnel at 0.01 s), else the study's.
-      const double h_rheonomic = scene.solver.rheonomic_time_step > 0
-                                     ? scene.solver.rheonomic_time_step
-                                     : o.rheonomic_time_step;
+      StepOverrides study_step;
+      study_step.rheonomic_default = o.rheonomic_time_step;
+      const double h_rheonomic = runStep(scene, Method::OdeRheonomic, study_step).time_step;
       const Method judge =
           entry.reference_judge ? Method::ReferenceFullVibration : Method::OdeFullVibration;
       r.judge = judge;

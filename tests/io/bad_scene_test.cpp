@@ -17,7 +17,7 @@
 #include <sstream>
 #include <string>
 
-#include "rheofeed/scene/builtin_scenes.hpp"
+#include "common/builtin_scenes.hpp"
 #include "rheofeed/scene/mesh.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 

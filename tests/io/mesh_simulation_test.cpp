@@ -12,7 +12,7 @@
 
 #include "rheofeed/scene/mesh.hpp"
 #include "rheofeed/scene/scene_io.hpp"
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
 namespace {

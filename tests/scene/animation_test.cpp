@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/scene/animation.hpp"
-#include "rheofeed/scene/metrics.hpp"
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/output/animation.hpp"
+#include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
 namespace {
@@ -384,7 +384,7 @@ TEST(Animation, PartsShowFromTheirSpawnUntilTheirRemoval) {
 TEST(Animation, MeasureRunRecordsEverySampleAndTheEnd) {
   Scene s = testScene();
   AnimationRecorder recorder(s, Method::OdeFullVibration);
-  const RunMetrics m = measureRun(s, Method::OdeFullVibration, {}, &recorder);
+  const RunMetrics m = measureRun(s, Method::OdeFullVibration, {}, {&recorder});
   EXPECT_EQ(recorder.samples(), static_cast<int>(m.series.size()) + 2);  // t = 0 and the end
   EXPECT_DOUBLE_EQ(recorder.duration(), m.simulated_seconds);
   EXPECT_EQ(static_cast<int>(recorder.nodeNames().size()), 2 + m.parts);

@@ -4,7 +4,7 @@
 // and edges), and stays quiet on the built-in and demo scenes that run well. The mass-ratio
 // limits are checked against ODE itself: a stack at the table's limit holds, ten times it does
 // not.
-#include "rheofeed/scene/check.hpp"
+#include "rheofeed/simulation/check.hpp"
 
 #include <gtest/gtest.h>
 #include <ode/ode.h>
@@ -14,9 +14,9 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "rheofeed/scene/builtin_scenes.hpp"
+#include "common/builtin_scenes.hpp"
 #include "rheofeed/scene/scene_io.hpp"
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
 namespace {

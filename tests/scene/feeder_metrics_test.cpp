@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/scene/metrics.hpp"
-#include "rheofeed/scene/output.hpp"
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/output/output.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
 namespace {

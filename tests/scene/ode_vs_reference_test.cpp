@@ -6,8 +6,8 @@
 
 #include <cmath>
 
-#include "rheofeed/scene/builtin_scenes.hpp"
-#include "rheofeed/scene/compare.hpp"
+#include "common/builtin_scenes.hpp"
+#include "rheofeed/measure/compare.hpp"
 
 namespace rheofeed::scene {
 namespace {

@@ -12,9 +12,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "rheofeed/scene/classical_model.hpp"
-#include "rheofeed/scene/metrics.hpp"
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/output/output.hpp"
+#include "rheofeed/measure/classical_model.hpp"
+#include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
 namespace {

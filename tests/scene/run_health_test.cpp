@@ -15,9 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/scene/builtin_scenes.hpp"
-#include "rheofeed/scene/metrics.hpp"
-#include "rheofeed/scene/simulation.hpp"
+#include "common/builtin_scenes.hpp"
+#include "rheofeed/output/output.hpp"
+#include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
 namespace {

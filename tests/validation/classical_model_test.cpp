@@ -10,7 +10,7 @@
 // - the mean speed of the hop that lasts exactly one cycle, pi g cot(beta) / w;
 // - the 1/f scaling at fixed throw number, the efficiency, the input checks, and the local
 //   parameters of a vibrating feeder (classicalTrack).
-#include "rheofeed/scene/classical_model.hpp"
+#include "rheofeed/measure/classical_model.hpp"
 
 #include <gtest/gtest.h>
 

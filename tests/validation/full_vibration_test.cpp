@@ -27,8 +27,8 @@
 #include <tuple>
 #include <utility>
 
-#include "rheofeed/scene/classical_model.hpp"
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/measure/classical_model.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
 

@@ -34,8 +34,8 @@
 
 #include "ode_world.hpp"
 #include "rheofeed/motion_law.hpp"
-#include "rheofeed/scene/classical_model.hpp"
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/measure/classical_model.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 #include "rheofeed/vibration_drift.hpp"
 
 namespace rheofeed {

@@ -9,9 +9,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "rheofeed/scene/builtin_scenes.hpp"
-#include "rheofeed/scene/calibration.hpp"
-#include "rheofeed/scene/metrics.hpp"
+#include "common/builtin_scenes.hpp"
+#include "rheofeed/measure/calibration.hpp"
+#include "rheofeed/measure/metrics.hpp"
 
 namespace rheofeed::scene {
 namespace {

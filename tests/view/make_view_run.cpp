@@ -10,8 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/scene/animation.hpp"
-#include "rheofeed/scene/metrics.hpp"
+#include "rheofeed/output/output.hpp"
+#include "rheofeed/output/animation.hpp"
+#include "rheofeed/measure/metrics.hpp"
 
 using namespace rheofeed;
 using namespace rheofeed::scene;
@@ -82,7 +83,7 @@ int main(int argc, char** argv) {
     const Scene scene = viewScene();
     const Method method = Method::OdeFullVibration;
     AnimationRecorder animation(scene, method);
-    const RunMetrics run = measureRun(scene, method, {}, &animation);
+    const RunMetrics run = measureRun(scene, method, {}, {&animation});
     std::vector<std::string> plots;
     for (const std::string& path : writeRunOutputs(run, folder.string(), "run")) {
       const std::filesystem::path p = path;

@@ -498,7 +498,7 @@ MotionLaw rheonomicLaw(const Scene& scene, int fixture) {
     case FeederLaw::Kind::Vibration:
       switch (law.drift_model) {
         case DriftModel::CalibratedDrift:
-          if (!law.has_calibrated_drift) {
+          if (lacksCalibration(law)) {
             throw std::invalid_argument(
                 where +
                 ": drift_model calibrated_drift needs a calibrated drift for a rheonomic method "
@@ -506,7 +506,7 @@ MotionLaw rheonomicLaw(const Scene& scene, int fixture) {
           }
           return MotionLaw::twist(law.calibrated_drift);
         case DriftModel::LocalSampled:
-          if (law.efficiency.empty()) {
+          if (lacksCalibration(law)) {
             throw std::invalid_argument(
                 where +
                 ": drift_model local_sampled needs the part families' efficiency factors for a "
@@ -521,6 +521,34 @@ MotionLaw rheonomicLaw(const Scene& scene, int fixture) {
       }
   }
   return MotionLaw{};
+}
+
+bool lacksCalibration(const FeederLaw& law) {
+  if (law.kind != FeederLaw::Kind::Vibration) return false;
+  switch (law.drift_model) {
+    case DriftModel::Local:
+      return false;
+    case DriftModel::LocalSampled:
+      return law.efficiency.empty();
+    case DriftModel::CalibratedDrift:
+      return !law.has_calibrated_drift;
+  }
+  return false;
+}
+
+bool needsCalibration(const Scene& scene) {
+  for (const Fixture& f : scene.fixtures) {
+    if (lacksCalibration(f.law)) return true;
+  }
+  return false;
+}
+
+void overrideDriftModel(Scene& scene, DriftModel model) {
+  for (Fixture& f : scene.fixtures) {
+    if (f.law.kind != FeederLaw::Kind::Vibration || f.law.drift_model == model) continue;
+    f.law.drift_model = model;
+    f.law.efficiency.clear();  // the scene's factors belong to its own local_sampled
+  }
 }
 
 std::vector<double> partEfficiencies(const Scene& scene) {

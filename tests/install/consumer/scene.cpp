@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Links the scene layer of the installed package (rheofeed::scene_io pulls rheofeed::scene, the
-// reference solver, Eigen, nlohmann-json and assimp): writes an empty scene as JSON.
+// Links the scene description of the installed package (rheofeed::scene: scenes and their JSON
+// files, no engine, plot or animation): writes an empty scene as JSON.
 #include <cstdio>
 #include <rheofeed/scene/scene_io.hpp>
 #include <string>

@@ -282,6 +282,18 @@ LocalVibration localVibration(const Vibration& vibration, const Vec3& gravity, d
 /// model has no efficiency factors ("run the calibration first").
 MotionLaw rheonomicLaw(const Scene& scene, int fixture);
 
+/// True when `law` is a vibration whose drift model (DriftModel) lacks its data for a rheonomic
+/// run: calibrated_drift without the drift, local_sampled without the efficiency factors (the
+/// local law needs none). rheonomicLaw refuses such a law.
+bool lacksCalibration(const FeederLaw& law);
+
+/// True when a rheonomic run of `scene` needs a calibration first (a fixture lacksCalibration).
+bool needsCalibration(const Scene& scene);
+
+/// Sets `model` on every vibrating fixture of `scene`, dropping the efficiency factors of the
+/// fixtures whose model changes (they belong to their own local_sampled calibration).
+void overrideDriftModel(Scene& scene, DriftModel model);
+
 /// The efficiency factor (dimensionless) of each part family (indexed like Scene::parts) on
 /// the scene's local-law feeders: the local_sampled feeders' factors, 1 where none is given.
 /// Throws std::invalid_argument naming both fixtures when two local-law feeders disagree on a

@@ -9,7 +9,7 @@
 #include <unordered_set>
 #include <vector>
 
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The scene check before the run (check.hpp). Every criterion is stated next to its code; the
 // mass-ratio limits are measured, and the command that measures them is given with the table.
-#include "rheofeed/scene/check.hpp"
+#include "rheofeed/simulation/check.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "rheofeed/scene/mesh.hpp"
+#include "rheofeed/scene/run_step.hpp"
 #include "simulation_internal.hpp"
 
 namespace rheofeed::scene {
@@ -368,11 +369,8 @@ std::vector<Hazard> checkScene(const Scene& scene, Method method) {
   const Vec3 up = g > 0 ? (-1.0 / g) * scene.gravity : Vec3{0, 0, 1};
   const bool full = isFullVibration(method);
   const bool ode = method == Method::OdeRheonomic || method == Method::OdeFullVibration;
-  // The scene field that sets this method's step: a rheonomic run of a scene that gives
-  // solver.rheonomic_time_step takes it (rheofeed run), every other run solver.time_step.
-  const std::string step_field = !full && scene.solver.rheonomic_time_step > 0
-                                     ? "solver.rheonomic_time_step"
-                                     : "solver.time_step";
+  // The scene field that sets this method's step (the time step rule, run_step.hpp).
+  const std::string step_field = stepField(scene, method);
 
   // Parts: the thinnest, the lightest and the heaviest over all families.
   double thinnest_part = kInf, lightest = kInf, heaviest = 0, light_thickness = kInf;
@@ -782,6 +780,19 @@ std::string formatHazards(const std::vector<Hazard>& hazards, const std::string&
     text += prefix + "  safe: " + h.safe_setting + "\n";
   }
   return text;
+}
+
+std::vector<std::string> reportSceneCheck(const Scene& scene, Method method) {
+  const std::vector<Hazard> hazards = checkScene(scene, method);
+  std::vector<std::string> lines;
+  for (const Hazard& hz : hazards) {
+    lines.push_back(std::string(toString(hz.kind)) + " at " + hz.where + ": " + hz.message +
+                    " (safe: " + hz.safe_setting + ")");
+  }
+  std::fprintf(
+      stderr, "%s",
+      formatHazards(hazards, "rheofeed: " + scene.name + ", " + toString(method) + ": ").c_str());
+  return lines;
 }
 
 }  // namespace rheofeed::scene

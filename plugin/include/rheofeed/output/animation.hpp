@@ -33,7 +33,8 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/simulation/run.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
 
@@ -41,8 +42,9 @@ namespace rheofeed::scene {
 /// diagonal of the scene's extent (SceneLimits::extent) plus this margin.
 constexpr double kPlaneMargin = 0.5;
 
-/// Records a run's part poses at the output samples and writes them as a .glb file.
-class AnimationRecorder {
+/// Records a run's part poses at the output samples and writes them as a .glb file. As a
+/// RunObserver (run.hpp) it records at t = 0, at every metric sample and after the last step.
+class AnimationRecorder : public RunObserver {
  public:
   /// Prepares the geometry of `scene` (validated by the caller, as makeSimulation does) for
   /// `method`; the parts are drawn as the simulation draws them (drawParts, same seed). Throws
@@ -51,10 +53,17 @@ class AnimationRecorder {
 
   /// Records the state of `sim` at sim.time() (s): every spawned part's pose and active flag,
   /// and the vibrating fixtures' displacement. Call it at t = 0 before the first step and then
-  /// at every output sample (measureRun does). A second call at the same time is ignored;
+  /// at every output sample (as a RunObserver of measureRun it does). A second call at the same time is ignored;
   /// a time earlier than the last one, a simulation of another method or with more parts than
   /// the scene draws throws std::invalid_argument naming the value.
   void record(const Simulation& sim);
+
+  /// RunObserver: record() at the start, on the sample steps and at the end.
+  void onStart(const Simulation& sim) override { record(sim); }
+  void onStep(const Simulation& sim, long, bool sample) override {
+    if (sample) record(sim);
+  }
+  void onEnd(const Simulation& sim) override { record(sim); }
 
   /// Writes the .glb to `path` atomically (temporary file and rename). Throws
   /// std::runtime_error naming the path on failure, std::logic_error when nothing was recorded.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "rheofeed/scene/compare.hpp"
+#include "rheofeed/measure/compare.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <limits>
 
-#include "rheofeed/scene/check.hpp"
+#include "rheofeed/simulation/check.hpp"
 
 namespace rheofeed::scene {
 namespace {

@@ -36,7 +36,7 @@
 //   centre crosses a surface again: on the outer side of the entry surface's plane is a deep
 //   penetration that recovered (parts_sunk), on its inner side a pass through
 //   (parts_through_fixture); leaving the scene while inside is a pass through too.
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 #include <algorithm>
 #include <cmath>

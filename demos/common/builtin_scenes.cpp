@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "rheofeed/scene/builtin_scenes.hpp"
+#include "common/builtin_scenes.hpp"
 
 #include <cmath>
 

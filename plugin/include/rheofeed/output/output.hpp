@@ -1,14 +1,15 @@
 // SPDX-License-Identifier: MIT
 /// @file output.hpp
-/// Writing result files so that no reader ever sees a half-written one, and the feeder metrics'
-/// files (FeederMetrics, metrics.hpp): CSV, JSON object and plots.
+/// Writing result files so that no reader ever sees a half-written one: a run's series CSV and
+/// JSON summary (RunMetrics, measure/metrics.hpp) and the feeder metrics' files (FeederMetrics):
+/// CSV, JSON object and plots.
 #pragma once
 
 #include <filesystem>
 #include <string>
 #include <vector>
 
-#include "rheofeed/scene/metrics.hpp"
+#include "rheofeed/measure/metrics.hpp"
 
 namespace rheofeed::scene {
 
@@ -43,5 +44,24 @@ std::string feederJson(const FeederMetrics& feeder);
 std::vector<std::string> writeFeederOutputs(const FeederMetrics& feeder,
                                             const std::filesystem::path& folder,
                                             const std::string& stem, const std::string& title);
+
+/// CSV of the series: time_s,parts,mean_velocity_mps,ci95_mps,mean_height_m,exited, then the
+/// parts lost so far by kind (cumulative counts, RunHealth): lost_fell,lost_through_fixture,
+/// lost_out_of_bounds,lost_nonfinite,lost_too_fast.
+std::string seriesCsv(const RunMetrics& run);
+
+/// One-line JSON summary of a run: all scalar fields, a "health" object with every count of
+/// RunHealth, parts_lost, the share of Coulomb fallback steps, the maximum part speed and its
+/// bound, and the list of ignored settings; the scene check's warnings; a "feeder" object
+/// (feederJson); and a "local_law" object (RunHealth::local_law: feeders, contacts,
+/// wall_contacts, cells_computed, model_runs).
+std::string summaryJson(const RunMetrics& run);
+
+/// Writes <stem>.csv, <stem>.json and, when gnuplot is available, <stem>.png (mean drift vs time
+/// with the 95 % band) into `folder`, each atomically; with an exit plane also the feeder
+/// outputs (writeFeederOutputs: <stem>_exits.csv, <stem>_orientation.csv and their plots).
+/// Returns the paths written; a missing gnuplot is reported on stderr and the PNGs skipped.
+std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::string& folder,
+                                         const std::string& stem);
 
 }  // namespace rheofeed::scene

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "rheofeed/scene/plot.hpp"
+#include "rheofeed/output/plot.hpp"
 
 #include <cstdio>
 #include <filesystem>

@@ -22,7 +22,7 @@
 //                              monotone and its first root is bracketed.
 // After every event the new phase is decided from the state a little after the event
 // (kLookAhead), which also settles grazing cases (a root where the function only touches 0).
-#include "rheofeed/scene/classical_model.hpp"
+#include "rheofeed/measure/classical_model.hpp"
 
 #include <algorithm>
 #include <array>

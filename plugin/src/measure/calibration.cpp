@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "rheofeed/scene/calibration.hpp"
+#include "rheofeed/measure/calibration.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,8 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "rheofeed/scene/classical_model.hpp"
-#include "rheofeed/scene/metrics.hpp"
+#include "rheofeed/measure/classical_model.hpp"
+#include "rheofeed/measure/metrics.hpp"
 
 namespace rheofeed::scene {
 namespace {

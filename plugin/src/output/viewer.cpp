@@ -6,8 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "rheofeed/scene/animation.hpp"
-#include "rheofeed/scene/output.hpp"
+#include "rheofeed/output/animation.hpp"
+#include "rheofeed/output/output.hpp"
 
 #ifndef RHEOFEED_THREE_DIR
 #define RHEOFEED_THREE_DIR "/usr/share/javascript/three"

@@ -5,7 +5,7 @@
 // and indices (UNSIGNED_INT, ELEMENT_ARRAY_BUFFER); the animation's shared input (the recorded
 // times, FLOAT SCALAR) and per node outputs (translation VEC3, rotation VEC4, scale VEC3). Every
 // accessor carries min and max (the spec requires them for POSITION and sampler inputs).
-#include "rheofeed/scene/animation.hpp"
+#include "rheofeed/output/animation.hpp"
 
 #include <tiny_gltf.h>
 
@@ -18,7 +18,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "rheofeed/scene/output.hpp"
+#include "rheofeed/output/output.hpp"
 
 namespace rheofeed::scene {
 namespace {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "rheofeed/scene/output.hpp"
+#include "rheofeed/output/output.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "rheofeed/scene/plot.hpp"
+#include "rheofeed/output/plot.hpp"
 
 namespace rheofeed::scene {
 

@@ -1,53 +1,13 @@
 // SPDX-License-Identifier: MIT
-#include "cli/calibrate_scene.hpp"
-
+// Calibrating what a scene's rheonomic runs need (calibration.hpp: calibrateScene), shared by
+// `rheofeed run` (calibrates what the scene does not give, every launch) and `rheofeed
+// calibrate` (calibrates once and writes the result into a copy of the scene).
 #include <sstream>
 #include <stdexcept>
 
-#include "rheofeed/scene/calibration.hpp"
+#include "rheofeed/measure/calibration.hpp"
 
-namespace rheofeed::cli {
-
-using namespace rheofeed::scene;
-
-namespace {
-
-// True when fixture `f`'s drift model lacks what it needs (scene.hpp DriftModel).
-bool lacksCalibration(const Fixture& f) {
-  if (f.law.kind != FeederLaw::Kind::Vibration) return false;
-  switch (f.law.drift_model) {
-    case DriftModel::Local:
-      return false;
-    case DriftModel::LocalSampled:
-      return f.law.efficiency.empty();
-    case DriftModel::CalibratedDrift:
-      return !f.law.has_calibrated_drift;
-  }
-  return false;
-}
-
-}  // namespace
-
-void overrideDriftModel(Scene& scene, const std::string& name) {
-  DriftModel model = DriftModel::Local;
-  if (!parseDriftModel(name, model)) {
-    throw std::invalid_argument("--drift-model " + name +
-                                ": unknown drift model; valid drift models: local, "
-                                "local_sampled, calibrated_drift");
-  }
-  for (Fixture& f : scene.fixtures) {
-    if (f.law.kind != FeederLaw::Kind::Vibration || f.law.drift_model == model) continue;
-    f.law.drift_model = model;
-    f.law.efficiency.clear();  // the scene's factors belong to its own local_sampled
-  }
-}
-
-bool needsCalibration(const Scene& scene) {
-  for (const Fixture& f : scene.fixtures) {
-    if (lacksCalibration(f)) return true;
-  }
-  return false;
-}
+namespace rheofeed::scene {
 
 CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
                                const std::string& label, std::FILE* log) {
@@ -65,7 +25,7 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
       ++report.local;
       continue;
     }
-    if (!lacksCalibration(scene.fixtures[i]) && !options.force) {
+    if (!lacksCalibration(scene.fixtures[i].law) && !options.force) {
       std::fprintf(log, "%s: fixture '%s': drift model %s, given by the scene\n", label.c_str(),
                    name.c_str(), toString(law.drift_model));
       ++report.given;
@@ -125,4 +85,4 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
   return report;
 }
 
-}  // namespace rheofeed::cli
+}  // namespace rheofeed::scene

@@ -23,7 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/scene/simulation.hpp"
+#include "rheofeed/simulation/run.hpp"
+#include "rheofeed/simulation/simulation.hpp"
 
 namespace rheofeed::scene {
 
@@ -140,56 +141,22 @@ struct RunMetrics {
   double real_time_factor = 0;
   /// What the run lost, could not trust or ignored (simulation.hpp).
   RunHealth health;
-  /// The scene check's warnings before the run (check.hpp: kind, values, safe setting), one
-  /// formatted line each; also printed on stderr when the run starts.
+  /// The scene check's warnings before the run (reportSceneCheck, simulation/check.hpp: kind,
+  /// values, safe setting), one formatted line each; filled by the caller of measureRun.
   std::vector<std::string> scene_check;
   /// Output rate, first exit, exit orientation per family.
   FeederMetrics feeder;
 };
 
-class AnimationRecorder;  // animation.hpp
-
-/// Progress report: fraction done in [0, 1].
-using Progress = std::function<void(double fraction)>;
-
-/// Runs `scene` with `method` for its duration and measures it (drift, health, and with an exit
-/// plane the FeederMetrics; a run with an exit plane that no part reached says so on stderr).
-/// Before the first step the scene
-/// check (checkScene) runs and its warnings go to stderr and into RunMetrics::scene_check.
-/// `progress` (optional) is called about a hundred times. Throws std::invalid_argument for an
-/// invalid scene. When the run lost parts, had reference steps it cannot trust or ignored settings
-/// (RunHealth::anything), one summary line is printed on stderr at the end (healthSummary).
-/// `animation` (optional, built from the same scene and method) records the run at t = 0, at
-/// every metric sample and at the end; the caller writes it (AnimationRecorder::write).
+/// Runs `scene` with `method` for its duration (runSimulation, run.hpp) and measures it (drift,
+/// health, and with an exit plane the FeederMetrics; a run with an exit plane that no part
+/// reached says so on stderr). `observers` (optional) watch the same run after the measurement
+/// (e.g. an AnimationRecorder, output/animation.hpp); the run's HealthReport comes last and
+/// prints what the run lost, could not trust or ignored (RunHealth::anything) on stderr.
+/// `progress` (optional) is called about a hundred times. The scene check is the caller's:
+/// run reportSceneCheck (simulation/check.hpp) before and put its lines into
+/// RunMetrics::scene_check. Throws std::invalid_argument for an invalid scene.
 RunMetrics measureRun(const Scene& scene, Method method, const Progress& progress = {},
-                      AnimationRecorder* animation = nullptr);
-
-/// A progress printer for stderr: "label: 42 %" on one refreshed line, at most every 0.5 s.
-Progress stderrProgress(const std::string& label);
-
-/// Two-sided 95 % Student-t quantile for `dof` degrees of freedom (1.96 for large dof).
-double studentT95(int dof);
-
-/// CSV of the series: time_s,parts,mean_velocity_mps,ci95_mps,mean_height_m,exited, then the
-/// parts lost so far by kind (cumulative counts, RunHealth): lost_fell,lost_through_fixture,
-/// lost_out_of_bounds,lost_nonfinite,lost_too_fast.
-std::string seriesCsv(const RunMetrics& run);
-/// One-line JSON summary of a run: all scalar fields, a "health" object with every count of
-/// RunHealth, parts_lost, the share of Coulomb fallback steps, the maximum part speed and its
-/// bound, and the list of ignored settings; the scene check's warnings; a "feeder" object
-/// (feederJson, output.hpp); and a "local_law" object (RunHealth::local_law: feeders, contacts,
-/// wall_contacts, cells_computed, model_runs).
-std::string summaryJson(const RunMetrics& run);
-/// One line naming what a run lost, could not trust or ignored, e.g. "3 of 60 parts lost
-/// (fell 2, through a fixture 1); ..."; "nothing lost" when RunHealth::anything() is false.
-std::string healthSummary(const RunHealth& health, int parts);
-
-/// Writes <stem>.csv, <stem>.json and, when gnuplot is available, <stem>.png (mean drift vs time
-/// with the 95 % band) into `folder`, each atomically; with an exit plane also the feeder
-/// outputs (writeFeederOutputs, output.hpp: <stem>_exits.csv, <stem>_orientation.csv and their
-/// plots). Returns the paths written; a missing gnuplot is reported on stderr and the PNGs
-/// skipped.
-std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::string& folder,
-                                         const std::string& stem);
+                      const std::vector<RunObserver*>& observers = {});
 
 }  // namespace rheofeed::scene

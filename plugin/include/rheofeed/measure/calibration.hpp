@@ -15,6 +15,7 @@
 /// conveying direction (no rotation terms); for a screw motion (torsion about an axis) it is a
 /// rotation about that axis.
 #pragma once
+#include <cstdio>
 
 #include <string>
 
@@ -110,5 +111,35 @@ EfficiencyCalibration calibrateEfficiency(const Scene& scene, int fixture, int f
 /// `calibration.efficiency` as the factor of `calibration.family` (the other families keep
 /// theirs, 1 when the fixture had none). Throws std::invalid_argument for a bad index.
 Scene withEfficiency(Scene scene, const EfficiencyCalibration& calibration);
+
+/// How the drift fields are found.
+struct CalibrateOptions {
+  /// The classical single-part model (calibrateClassical: milliseconds, a straight-track
+  /// estimate) instead of a full-vibration sample run (calibrateBySampling: seconds to a minute).
+  bool classical = false;
+  /// Calibrate every vibrating fixture whose drift model takes a calibration, also when the
+  /// scene already gives it.
+  bool force = false;
+  /// The step (s) of the rheonomic runs: calibrateEfficiency runs the local law at it.
+  double rheonomic_time_step = 0.01;
+};
+
+/// What calibrateScene did.
+struct CalibrateReport {
+  int calibrated = 0;  ///< fixtures calibrated now
+  int given = 0;       ///< vibrating fixtures whose calibration the scene gives (not calibrated)
+  int local = 0;       ///< vibrating fixtures on the local law (nothing to calibrate)
+  double cpu_seconds = 0;  ///< CPU time of the calibrations (s)
+  std::string summary;     ///< one line per calibrated fixture: value, 95 % interval, how
+};
+
+/// Calibrates the vibrating fixtures of `scene` that need it (all but the local-law ones with
+/// options.force) and stores the results in it: calibrated_drift by calibrateBySampling (or
+/// calibrateClassical) and withCalibration, local_sampled by calibrateEfficiency per part family
+/// and withEfficiency. Each calibration is announced on `log` before it starts
+/// ("<label>: calibrating fixture ...") and its result printed after. Throws what the
+/// calibration throws (std::invalid_argument for a scene it cannot calibrate).
+CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
+                               const std::string& label, std::FILE* log);
 
 }  // namespace rheofeed::scene

@@ -87,6 +87,12 @@ std::vector<Hazard> checkScene(const Scene& scene, Method method);
 /// Empty for no hazards.
 std::string formatHazards(const std::vector<Hazard>& hazards, const std::string& prefix = "");
 
+/// What a caller does before a run: checkScene for `method`, the hazards printed on stderr
+/// (formatHazards, prefixed "rheofeed: <scene>, <method>: ") and returned one line each,
+/// "<kind> at <where>: <message> (safe: <safe_setting>)", for the run's outputs
+/// (RunMetrics::scene_check).
+std::vector<std::string> reportSceneCheck(const Scene& scene, Method method);
+
 /// The largest heaviest/lightest part mass ratio that a stack holds (penetration below a
 /// quarter of the light part's thickness) with ODE's quickstep at `iterations` and a light
 /// part of thickness `thickness` (m) at step `time_step` (s) under gravity `g` (m/s^2), from

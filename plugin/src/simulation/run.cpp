@@ -1,0 +1,132 @@
+// SPDX-License-Identifier: MIT
+// The run loop (run.hpp) and the end-of-run health report.
+#include "rheofeed/simulation/run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+namespace rheofeed::scene {
+
+RunSchedule runSchedule(const Scene& scene) {
+  const double h = scene.solver.time_step;
+  RunSchedule s;
+  s.steps = std::lround(scene.duration / h);
+  s.sample_every = std::max(1L, std::lround(scene.outputs.sample_interval / h));
+  return s;
+}
+
+Progress stderrProgress(const std::string& label) {
+  auto last = std::make_shared<std::chrono::steady_clock::time_point>();
+  return [label, last](double f) {
+    const auto now = std::chrono::steady_clock::now();
+    if (f < 1.0 && now - *last < std::chrono::milliseconds(500)) return;
+    *last = now;
+    std::fprintf(stderr, "\r%s: %3.0f %%%s", label.c_str(), 100 * f, f >= 1.0 ? "\n" : "");
+    std::fflush(stderr);
+  };
+}
+
+void runSimulation(Simulation& sim, const RunSchedule& schedule,
+                   const std::vector<RunObserver*>& observers, const Progress& progress) {
+  const long report_every = std::max(1L, schedule.steps / 100);
+  for (RunObserver* o : observers) {
+    if (o) o->onStart(sim);
+  }
+  for (long k = 1; k <= schedule.steps; ++k) {
+    sim.step();
+    const bool sample = k % schedule.sample_every == 0;
+    for (RunObserver* o : observers) {
+      if (o) o->onStep(sim, k, sample);
+    }
+    if (progress && k % report_every == 0) progress(double(k) / schedule.steps);
+  }
+  for (RunObserver* o : observers) {
+    if (o) o->onEnd(sim);
+  }
+  if (progress) progress(1.0);
+}
+
+void HealthReport::onEnd(const Simulation& sim) {
+  const RunHealth& h = sim.health();
+  if (h.anything()) {
+    std::fprintf(stderr, "rheofeed: %s, %s: %s\n", scene_name_.c_str(), toString(sim.method()),
+                 healthSummary(h, sim.numParts()).c_str());
+  }
+  if (h.local_law_feeders > 0) {
+    const LocalDriftStats& l = h.local_law;
+    std::fprintf(stderr,
+                 "rheofeed: %s, %s: local vibration law on %d feeder(s): %lld contacts driven "
+                 "(%lld on walls or steep faces), %lld drift table cells, %lld point-mass runs\n",
+                 scene_name_.c_str(), toString(sim.method()), h.local_law_feeders,
+                 static_cast<long long>(l.contacts), static_cast<long long>(l.wall_contacts),
+                 static_cast<long long>(l.cells_computed), static_cast<long long>(l.model_runs));
+  }
+}
+
+std::string healthSummary(const RunHealth& h, int parts) {
+  if (!h.anything()) return "nothing lost";
+  std::ostringstream s;
+  const char* separator = "";
+  if (h.partsLost() > 0) {
+    s << h.partsLost() << " of " << parts << " parts lost (";
+    const std::pair<const char*, int> kinds[] = {{"fell", h.parts_fell},
+                                                 {"through a fixture", h.parts_through_fixture},
+                                                 {"out of bounds", h.parts_out_of_bounds},
+                                                 {"non-finite", h.parts_nonfinite},
+                                                 {"too fast", h.parts_too_fast},
+                                                 {"inside a fixture now", h.parts_inside_fixture}};
+    const char* comma = "";
+    for (const auto& [name, count] : kinds) {
+      if (count == 0) continue;
+      s << comma << name << " " << count;
+      comma = ", ";
+    }
+    s << ")";
+    if (h.parts_too_fast > 0) {
+      s << ", max speed " << h.max_part_speed << " m/s (bound " << h.speed_bound << " m/s)";
+    }
+    separator = "; ";
+  }
+  if (h.parts_sunk > 0) {
+    s << separator << h.parts_sunk << (h.parts_sunk == 1 ? " part" : " parts")
+      << " sank into a fixture by more than half their size "
+      << "and came back";
+    separator = "; ";
+  }
+  if (h.coulomb_fallback_steps > 0) {
+    s << separator << h.coulomb_fallback_steps << " of " << h.steps << " steps used the Coulomb "
+      << "fallback (" << 100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps) << " %)";
+    separator = "; ";
+  }
+  if (h.solver_unconverged_steps > 0) {
+    s << separator << h.solver_unconverged_steps << " of " << h.steps
+      << " steps with an unconverged contact solve";
+    separator = "; ";
+  }
+  if (h.friction_dropped_contacts > 0) {
+    s << separator << h.friction_dropped_contacts
+      << " contact friction impulses dropped by the Coulomb fallback";
+    separator = "; ";
+  }
+  if (h.gyroscopic_fallback_steps > 0) {
+    s << separator << h.gyroscopic_fallback_steps
+      << " steps with a dissipative gyroscopic fallback";
+    separator = "; ";
+  }
+  if (!h.ignored_settings.empty()) {
+    s << separator << h.ignored_settings.size() << " ignored setting"
+      << (h.ignored_settings.size() > 1 ? "s" : "") << " (";
+    for (std::size_t k = 0; k < h.ignored_settings.size(); ++k) {
+      const std::string& line = h.ignored_settings[k];
+      s << (k ? ", " : "") << line.substr(0, line.find(" ="));
+    }
+    s << ")";
+  }
+  return s.str();
+}
+
+}  // namespace rheofeed::scene
