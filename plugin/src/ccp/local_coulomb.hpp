@@ -47,3 +47,25 @@ double localCoulombResidual(const Eigen::Matrix3d& w, const Eigen::Vector3d& q, 
                             const Eigen::Vector3d& r);
 
 }  // namespace rheofeed::ccp::detail
+
+namespace rheofeed::ccp::detail {
+
+/// Largest group of contacts solved together by solveGroupCoulomb (contacts).
+constexpr int kMaxGroupContacts = 8;
+
+/// Dense matrices and vectors of a group's local problem without heap allocation.
+using GroupMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3 * kMaxGroupContacts,
+                                  3 * kMaxGroupContacts>;
+using GroupVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3 * kMaxGroupContacts, 1>;
+
+/// Solves the Coulomb problem of a group of k contacts (2 <= k <= kMaxGroupContacts, e.g. the
+/// corners of one box on the floor, whose Delassus block is rank deficient up to the
+/// compliance) at once: `w` the group's block of N (3k x 3k, 1/kg), `q` the velocity of
+/// everything else (3k, m/s), `mu` (k). Nonsmooth Newton on the group's Alart-Curnier function
+/// (each contact scaled by its own diagonal block) with a line search; when it stalls, passes
+/// of one-contact solves over the group as fallback. `r` (3k, N s) is the initial guess on
+/// entry and the solution on exit (in the cones).
+LocalOutcome solveGroupCoulomb(const GroupMatrix& w, const GroupVector& q, const GroupVector& mu,
+                               const LocalSettings& settings, GroupVector& r);
+
+}  // namespace rheofeed::ccp::detail

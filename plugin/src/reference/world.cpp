@@ -186,6 +186,10 @@ void World::setFrictionCallback(FrictionCallback callback) {
   impl_->friction = std::move(callback);
 }
 
+void World::setStepObserver(StepObserver observer) {
+  impl_->observer = std::move(observer);
+}
+
 void World::addForce(BodyId body, const Vec3& force, const Vec3& torque) {
   if (body < 0 || body >= numBodies())
     refuse("addForce: body " + std::to_string(body) + " does not exist");
@@ -230,6 +234,7 @@ StepReport World::step(double h) {
   s.contacts = std::move(c.out);
   integrationStage(c);
   s.time += h;
+  if (s.observer) s.observer(*this, c.report);
   return std::move(c.report);
 }
 

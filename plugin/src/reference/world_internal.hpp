@@ -139,6 +139,7 @@ struct WorldState {
   std::vector<Feeder> feeders;
   std::unordered_map<dGeomID, std::size_t> feeder_index;
   FrictionCallback friction;
+  StepObserver observer;
   ccp::Solver solver;
   ccp::NsgsSolver nsgs;
   std::vector<RawContact> raw;

@@ -135,6 +135,12 @@ struct NsgsSettings {
   /// Use the incoming gamma (projected onto K) as the initial guess when it has the right size
   /// and finite entries; otherwise start from zero.
   bool warm_start = true;
+  /// Solve the contacts of one pair of bodies (matrix-free problems: the same generalised
+  /// velocities; dense: the same coupling pattern) together, up to 8 at a time, by a Newton
+  /// step on their coupled block: the corners of a box on the floor are rank deficient up to
+  /// the compliance, and one contact at a time redistributes their normal impulses only at the
+  /// compliance's pace. false: one contact at a time.
+  bool group_contacts = false;
   /// Nonsmooth Newton iterations of one local solve (>= 1).
   int local_newton_iterations = 30;
   /// Iterations of the local projection fallback when Newton stalls (>= 0).

@@ -150,12 +150,22 @@ struct Settings {
   /// NSGS settings for coulomb_solver == Nsgs. Its tolerance, residual_rho and time limit are
   /// taken from `solver` (tolerance: the Coulomb tolerance of the step); the rest as given.
   ccp::NsgsSettings nsgs;
+  /// NSGS: visit the contacts from the highest to the lowest along -gravity (the order of the
+  /// contact problem), so that a sweep carries a pile's weight down in one pass; false keeps
+  /// the collision order.
+  bool nsgs_top_down = true;
   /// Use the dense Delassus matrix up to this many contacts, matrix-free above.
   int dense_contact_limit = 100;
 };
 
 /// Friction coefficient for a pair of geoms (dimensionless, >= 0).
 using FrictionCallback = std::function<double(dGeomID g1, dGeomID g2)>;
+
+struct StepReport;
+/// Called by World::step at the end of every step (after integration), with the world and the
+/// step's report: lastContactProblem(world) is then the step's contact problem. It may read
+/// the world but not step it; an exception it throws leaves World::step.
+using StepObserver = std::function<void(const World& world, const StepReport& report)>;
 
 /// What one step did.
 struct StepReport {
@@ -222,6 +232,8 @@ class World {
   void setBodyEfficiency(BodyId body, double factor);
   /// Per-pair friction coefficient (default: Settings::default_mu everywhere).
   void setFrictionCallback(FrictionCallback callback);
+  /// Observer of every step (none by default; an empty function removes it).
+  void setStepObserver(StepObserver observer);
   /// External force (N) and torque (N m) on a body for the next step only (world frame).
   void addForce(BodyId body, const Vec3& force, const Vec3& torque = {});
 
