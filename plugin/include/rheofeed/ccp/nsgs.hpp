@@ -14,7 +14,8 @@
 /// contacts in turn and solves each one's 3 x 3 Coulomb problem exactly (local_coulomb.cpp:
 /// closed forms for take-off and stick, an Alart-Curnier nonsmooth Newton scaled by the
 /// contact's own Delassus block with a line search for slip, and a projection fixed point as
-/// fallback), with the other contacts' impulses frozen at their latest values. Matrix-free
+/// fallback), with the other contacts' impulses frozen at their latest values; optionally the
+/// contacts of one pair of bodies are solved together (NsgsSettings::group_contacts). Matrix-free
 /// problems are swept through the generalised velocity `M^-1 D gamma`, touching only the
 /// columns of the contact's bodies, so thousands of contacts cost O(nnz(D)) per sweep.
 ///
@@ -32,8 +33,9 @@
 
 namespace rheofeed::ccp {
 
-/// NSGS solver with a reusable workspace (no heap allocation for a repeated problem size).
-/// Not thread safe. Never throws for bad input (Status::InvalidInput).
+/// NSGS solver with a reusable workspace. Unlike Solver it allocates in every solve (the contact
+/// groups and their lists are rebuilt from the problem). Not thread safe. Never throws for bad
+/// input (Status::InvalidInput).
 class NsgsSolver {
  public:
   /// A solver with default NsgsSettings.
