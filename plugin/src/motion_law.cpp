@@ -568,9 +568,9 @@ Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h) {
   double m[3][3];
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
-      const double p0 = a[3 * i] * b[3 * j], p1 = a[3 * i + 1] * b[3 * j + 1],
-                   p2 = a[3 * i + 2] * b[3 * j + 2];
-      m[i][j] = i < 2 ? (p0 + p1) + p2 : p0 + (p1 + p2);
+      const double t0 = a[3 * i] * b[3 * j], t1 = a[3 * i + 1] * b[3 * j + 1],
+                   t2 = a[3 * i + 2] * b[3 * j + 2];
+      m[i][j] = i < 2 ? (t0 + t1) + t2 : t0 + (t1 + t2);
     }
   }
   double q[3];  // vector part (x, y, z)

@@ -125,20 +125,10 @@ void projectOntoCones(Eigen::VectorXd& gamma, const Eigen::VectorXd& mu) {
   }
 }
 
-}  // namespace detail
-
-namespace {
-
-std::string format(const char* fmt, double a, double b = 0.0) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof buffer, fmt, a, b);
-  return std::string(buffer);
-}
-
 // Fills the measures of `result` for impulses gamma with u = N gamma + r (u given).
 void computeMeasures(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
-                     const Eigen::VectorXd& r, const Eigen::VectorXd& mu, double rho,
-                     detail::Workspace& ws, Result& result) {
+                     const Eigen::VectorXd& r, const Eigen::VectorXd& mu, double rho, Workspace& ws,
+                     Result& result) {
   double dual = 0.0;
   double complementarity = 0.0;
   for (Eigen::Index i = 0; i < mu.size(); ++i) {
@@ -151,7 +141,17 @@ void computeMeasures(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
   result.complementarity = complementarity;
   // 1/2 g^T N g + r^T g with N g = u - r.
   result.objective = 0.5 * gamma.dot(u + r);
-  result.coulomb_distance = detail::relativeResidual(gamma, u, r, mu, rho, true, ws);
+  result.coulomb_distance = relativeResidual(gamma, u, r, mu, rho, true, ws);
+}
+
+}  // namespace detail
+
+namespace {
+
+std::string format(const char* fmt, double a, double b = 0.0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, fmt, a, b);
+  return std::string(buffer);
 }
 
 }  // namespace
@@ -462,8 +462,8 @@ void finish(SolveContext& c) {
     result.message = format("time limit of %g s reached", c.deadline.limit());
   }
   c.physicalVelocity();
-  computeMeasures(c.gamma, c.ws.u, c.problem.r, c.problem.mu, c.settings.residual_rho, c.ws,
-                  result);
+  detail::computeMeasures(c.gamma, c.ws.u, c.problem.r, c.problem.mu, c.settings.residual_rho, c.ws,
+                          result);
   if (c.settings.coulomb_outer_iterations == 0) {
     result.residual = detail::relativeResidual(c.gamma, c.ws.u, c.problem.r, c.problem.mu,
                                                c.settings.residual_rho, false, c.ws);

@@ -21,6 +21,16 @@ using detail::toEigen;
 using detail::toQuat;
 using Impl = WorldState;
 
+const char* toString(CoulombSolver solver) {
+  switch (solver) {
+    case CoulombSolver::Nsgs:
+      return "NSGS";
+    case CoulombSolver::RelaxedFixedPoint:
+      return "RelaxedFixedPoint";
+  }
+  return "Unknown";
+}
+
 namespace {
 
 // Empty when `settings` are usable, else a message naming the first bad value. Checked by the
@@ -50,6 +60,14 @@ std::string settingsProblem(const Settings& settings) {
     bad << "Settings::gravity is not finite";
   else if (std::string m = settings.solver.validate(); !m.empty())
     bad << "Settings::solver: " << m;
+  else if (!(settings.warm_start_distance >= 0) || !std::isfinite(settings.warm_start_distance))
+    bad << "Settings::warm_start_distance = " << settings.warm_start_distance
+        << " must be finite and >= 0 (m)";
+  else if (settings.coulomb_solver != CoulombSolver::Nsgs &&
+           settings.coulomb_solver != CoulombSolver::RelaxedFixedPoint)
+    bad << "Settings::coulomb_solver is not Nsgs or RelaxedFixedPoint";
+  else if (std::string nsgs = settings.nsgs.validate(); !nsgs.empty())
+    bad << "Settings::nsgs: " << nsgs;
   return bad.str();
 }
 
@@ -168,6 +186,10 @@ void World::setFrictionCallback(FrictionCallback callback) {
   impl_->friction = std::move(callback);
 }
 
+void World::setStepObserver(StepObserver observer) {
+  impl_->observer = std::move(observer);
+}
+
 void World::addForce(BodyId body, const Vec3& force, const Vec3& torque) {
   if (body < 0 || body >= numBodies())
     refuse("addForce: body " + std::to_string(body) + " does not exist");
@@ -212,6 +234,7 @@ StepReport World::step(double h) {
   s.contacts = std::move(c.out);
   integrationStage(c);
   s.time += h;
+  if (s.observer) s.observer(*this, c.report);
   return std::move(c.report);
 }
 

@@ -5,6 +5,7 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <utility>
 
 #include "world_internal.hpp"
@@ -130,16 +131,38 @@ void problemStage(StepContext& c) {
   }
 }
 
-// The initial impulses: last step's per (geom pair, contact index), or zero. Writes c.gamma.
+// The initial impulses: for each contact, the world-frame impulse of the nearest unclaimed
+// contact of the same geom pair in the last step within Settings::warm_start_distance,
+// expressed in the new frame (n, t1, t2); zero otherwise. Writes c.gamma.
 void warmStartStage(StepContext& c) {
   WorldState& s = c.s;
   c.gamma = Eigen::VectorXd::Zero(3 * c.nc);
   if (!c.cfg.warm_start) return;
+  const double limit = c.cfg.warm_start_distance;
+  std::map<std::pair<dGeomID, dGeomID>, std::size_t> first_claim;  // offset into warm_claimed
   for (int i = 0; i < c.nc; ++i) {
     const WorldState::RawContact& raw = s.raw[static_cast<std::size_t>(i)];
-    auto it = s.warm.find({raw.g1, raw.g2, raw.index});
-    if (it != s.warm.end()) c.gamma.segment<3>(3 * i) = it->second;
+    auto it = s.warm.find({raw.g1, raw.g2});
+    if (it == s.warm.end()) continue;
+    const std::vector<WorldState::WarmContact>& last = it->second;
+    auto [claim, fresh] = first_claim.try_emplace(it->first, s.warm_claimed.size());
+    if (fresh) s.warm_claimed.resize(s.warm_claimed.size() + last.size(), 0);
+    std::size_t best = last.size();
+    double best_distance = limit;
+    for (std::size_t k = 0; k < last.size(); ++k) {
+      if (s.warm_claimed[claim->second + k]) continue;
+      const double distance = (last[k].position - raw.p).norm();
+      if (distance <= best_distance) {
+        best_distance = distance;
+        best = k;
+      }
+    }
+    if (best == last.size()) continue;
+    s.warm_claimed[claim->second + best] = 1;
+    c.gamma.segment<3>(3 * i) =
+        c.frames[static_cast<std::size_t>(i)].transpose() * last[best].impulse;
   }
+  s.warm_claimed.clear();
 }
 
 // The contact solve, its fallback flags and the guard against non-finite impulses. Writes
@@ -149,22 +172,35 @@ void solveStage(StepContext& c) {
   const Settings& cfg = c.cfg;
   StepReport& report = c.report;
   Eigen::VectorXd& gamma = c.gamma;
-  s.solver.settings() = cfg.solver;
-  s.solver.settings().coulomb_max_separation =
-      std::max(cfg.solver.coulomb_max_separation,
-               detail::kSpuriousSeparationShare * toEigen(cfg.gravity).norm() * c.h);
-  report.solve = s.solver.solve(s.problem, gamma);
-  // When the true-Coulomb fixed point does not settle, the solver returns its outer iterate
-  // with the lowest Coulomb residual, and the step uses it, normals corrected when it
-  // separates a pressed contact faster than coulomb_max_separation (solver.cpp). The relaxed CCP
-  // is no fallback: it separates every sliding contact at u_n = mu |u_t| (a box on a 10 m/s belt
-  // with mu = 0.5 leaves at 5 m/s). A shifted iterate k + 1 separates a sliding contact only by
-  // mu (|u_t^(k+1)| - |u_t^(k)|), the change of slip between iterates, and the Coulomb
-  // residual (reported) bounds that: with rho = 1 a pressed contact's normal velocity error is
-  // at most coulomb_residual (1 + |r|) (m/s).
-  report.coulomb_fallback =
-      cfg.solver.coulomb_outer_iterations > 0 && report.solve.status == ccp::Status::MaxIterations;
-  report.coulomb_residual = report.solve.coulomb_distance;
+  const bool nsgs =
+      cfg.solver.coulomb_outer_iterations > 0 && cfg.coulomb_solver == CoulombSolver::Nsgs;
+  if (nsgs) {
+    ccp::NsgsSettings& settings = s.nsgs.settings();
+    settings = cfg.nsgs;
+    settings.tolerance = cfg.solver.tolerance;
+    settings.residual_rho = cfg.solver.residual_rho;
+    settings.time_limit_s = cfg.solver.time_limit_s;
+    settings.warm_start = true;  // gamma is zero without Settings::warm_start
+    report.solve = s.nsgs.solve(s.problem, gamma);
+    report.coulomb_residual = report.solve.coulomb_distance;
+  } else {
+    s.solver.settings() = cfg.solver;
+    s.solver.settings().coulomb_max_separation =
+        std::max(cfg.solver.coulomb_max_separation,
+                 detail::kSpuriousSeparationShare * toEigen(cfg.gravity).norm() * c.h);
+    report.solve = s.solver.solve(s.problem, gamma);
+    // When the true-Coulomb fixed point does not settle, the solver returns its outer iterate
+    // with the lowest Coulomb residual, and the step uses it, normals corrected when it
+    // separates a pressed contact faster than coulomb_max_separation (solver.cpp). The relaxed
+    // CCP is no fallback: it separates every sliding contact at u_n = mu |u_t| (a box on a
+    // 10 m/s belt with mu = 0.5 leaves at 5 m/s). A shifted iterate k + 1 separates a sliding
+    // contact only by mu (|u_t^(k+1)| - |u_t^(k)|), the change of slip between iterates, and the
+    // Coulomb residual (reported) bounds that: with rho = 1 a pressed contact's normal velocity
+    // error is at most coulomb_residual (1 + |r|) (m/s).
+    report.coulomb_fallback = cfg.solver.coulomb_outer_iterations > 0 &&
+                              report.solve.status == ccp::Status::MaxIterations;
+    report.coulomb_residual = report.solve.coulomb_distance;
+  }
   if (report.solve.status == ccp::Status::InvalidInput) {
     detail::refuse("step: the contact problem was refused: " + report.solve.message);
   }
@@ -192,7 +228,9 @@ void recordStage(StepContext& c) {
   for (int i = 0; i < c.nc; ++i) {
     const WorldState::RawContact& raw = s.raw[static_cast<std::size_t>(i)];
     const Matrix3d& f = c.frames[static_cast<std::size_t>(i)];
-    s.warm[{raw.g1, raw.g2, raw.index}] = gamma.segment<3>(3 * i);
+    s.warm[{raw.g1, raw.g2}].push_back(
+        {raw.p,
+         f.col(0) * gamma(3 * i) + f.col(1) * gamma(3 * i + 1) + f.col(2) * gamma(3 * i + 2)});
     ContactImpulse& ci = c.out[static_cast<std::size_t>(i)];
     ci.g1 = raw.g1;
     ci.g2 = raw.g2;

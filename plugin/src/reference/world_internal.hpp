@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "ode_vec.hpp"  // the ODE <-> rheofeed conversions (toVec3, setGeomPose)
+#include "rheofeed/ccp/nsgs.hpp"
 #include "rheofeed/ccp/problem.hpp"
 #include "rheofeed/ccp/solver.hpp"
 #include "rheofeed/reference/world.hpp"
@@ -120,7 +121,7 @@ struct WorldState {
     BodyId a, b;
     Vector3d p, n;
     double depth, mu;
-    int index;  // position among the pair's contacts (warm start key)
+    int index;  // position among the pair's contacts
   };
 
   Settings settings;
@@ -137,10 +138,19 @@ struct WorldState {
   std::vector<Feeder> feeders;
   std::unordered_map<dGeomID, std::size_t> feeder_index;
   FrictionCallback friction;
+  StepObserver observer;
   ccp::Solver solver;
+  ccp::NsgsSolver nsgs;
   std::vector<RawContact> raw;
   std::vector<ContactImpulse> contacts;
-  std::map<std::tuple<dGeomID, dGeomID, int>, Vector3d> warm;
+  // Last step's contacts per geom pair (dCollide's order): point and impulse on g1's body, both
+  // world frame (the warm start).
+  struct WarmContact {
+    Vector3d position;
+    Vector3d impulse;
+  };
+  std::map<std::pair<dGeomID, dGeomID>, std::vector<WarmContact>> warm;
+  std::vector<char> warm_claimed;  // scratch of warmStartStage
   std::vector<dContactGeom> scratch;
   ccp::Problem problem;  // the last step's contact problem
 

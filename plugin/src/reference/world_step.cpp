@@ -4,6 +4,7 @@
 // gyroscopic rotation), collision detection, and the semi-implicit Euler integration. The
 // contact stages between collision and integration are in world_contacts.cpp.
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -156,6 +157,17 @@ void collisionStage(StepContext& c) {
   if (s.collide_error) {
     s.raw.clear();
     std::rethrow_exception(std::exchange(s.collide_error, nullptr));
+  }
+  if (c.cfg.solver.coulomb_outer_iterations > 0 && c.cfg.coulomb_solver == CoulombSolver::Nsgs &&
+      c.cfg.nsgs_top_down) {
+    // Top first, against gravity: a Gauss-Seidel sweep then carries a heap's weight from the
+    // top contact to the floor in one pass (as shock propagation orders its layers). Stable, so
+    // that contacts at one height keep the collision order.
+    const Vector3d up = -toEigen(c.cfg.gravity);
+    std::stable_sort(s.raw.begin(), s.raw.end(),
+                     [&up](const WorldState::RawContact& a, const WorldState::RawContact& b) {
+                       return a.p.dot(up) > b.p.dot(up);
+                     });
   }
 }
 

@@ -99,6 +99,64 @@ struct Settings {
   std::string validate() const;
 };
 
+/// Order in which NSGS visits the contacts within a sweep.
+enum class ContactOrder {
+  /// The problem's order every sweep.
+  Given,
+  /// The problem's order, then reversed, alternately (symmetric Gauss-Seidel).
+  Alternating,
+  /// A fresh pseudo-random permutation every sweep after the first (fixed seed: reproducible).
+  Shuffled,
+};
+
+/// Printable name of a ContactOrder ("Given", "Alternating", "Shuffled").
+const char* toString(ContactOrder order);
+
+/// Settings of the NSGS true-Coulomb solver (nsgs.hpp). Defaults are in the class; all are
+/// checked by NsgsSolver::solve().
+struct NsgsSettings {
+  /// Sweep budget (>= 1): one sweep solves every contact's local problem once.
+  int max_iterations = 1000;
+  /// Stop when the Coulomb residual (Result::coulomb_distance, dimensionless, scale invariant)
+  /// is at or below this value (finite, >= 0).
+  double tolerance = 1e-8;
+  /// Multiplier of the residual's per-contact natural map step, as Settings::residual_rho
+  /// (dimensionless, > 0).
+  double residual_rho = 1.0;
+  /// Relaxation of each contact update, `gamma_i <- Pi_K(gamma_i + omega (g - gamma_i))` with g
+  /// the local solution (dimensionless, 0 < omega < 2; 1 means none).
+  double omega = 1.0;
+  /// Contact order within a sweep.
+  ContactOrder order = ContactOrder::Given;
+  /// Proximal term of the local problems, `eta = proximal_weight * trace(N_ii) / 3` (1/kg) added
+  /// to the block and `eta gamma_i` to the local free velocity (dimensionless, >= 0; 0 = off).
+  /// The solution is unchanged; each update is damped and rank-deficient blocks regularised.
+  double proximal_weight = 0.0;
+  /// Use the incoming gamma (projected onto K) as the initial guess when it has the right size
+  /// and finite entries; otherwise start from zero.
+  bool warm_start = true;
+  /// Solve the contacts of one pair of bodies (matrix-free problems: the same generalised
+  /// velocities; dense: the same coupling pattern) together, up to 8 at a time, by a Newton
+  /// step on their coupled block: the corners of a box on the floor are rank deficient up to
+  /// the compliance, and one contact at a time redistributes their normal impulses only at the
+  /// compliance's pace. false: one contact at a time.
+  bool group_contacts = false;
+  /// Nonsmooth Newton iterations of one local solve (>= 1).
+  int local_newton_iterations = 30;
+  /// Iterations of the local projection fallback when Newton stalls (>= 0).
+  int local_projection_iterations = 100;
+  /// Local stopping test on the contact's own relative Coulomb residual (finite, > 0).
+  double local_tolerance = 1e-13;
+  /// Recompute the maintained velocities from scratch every this many sweeps (>= 1) to remove
+  /// round-off drift (always before convergence is declared).
+  int refresh_interval = 32;
+  /// Wall-clock budget of the whole solve (s); 0 means none (then Status::MaxIterations).
+  double time_limit_s = 0.0;
+
+  /// Empty when the settings are usable, else a message naming the bad field and its value.
+  std::string validate() const;
+};
+
 /// What a solve produced. Measures are defined in this file's header comment; they are NaN
 /// when not computed (NotRun, InvalidInput).
 struct Result {
@@ -140,6 +198,12 @@ struct Result {
   double objective = std::numeric_limits<double>::quiet_NaN();
   /// Relative residual of the true Coulomb law (dimensionless), for the problem's own `r`.
   double coulomb_distance = std::numeric_limits<double>::quiet_NaN();
+  /// NSGS: local contact solves whose nonsmooth Newton stalled and that took the projection
+  /// fallback, summed over sweeps (0 for PGS and APGD).
+  int local_fallbacks = 0;
+  /// NSGS: local solves that met neither Newton's nor the fallback's tolerance (their best
+  /// impulse was used), summed over sweeps; included in local_fallbacks.
+  int local_unconverged = 0;
   /// Wall-clock time of solve() (s).
   double solve_time_s = 0.0;
 };
