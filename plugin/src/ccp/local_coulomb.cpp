@@ -293,10 +293,10 @@ struct GroupAlartCurnier {
         const Eigen::Matrix2d tangent = Eigen::Matrix2d::Identity() - unit * unit.transpose();
         dp = (radius / nb) * tangent * db;
         if (a > 0.0) {
-          Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, 3 * kMaxGroupContacts> da =
-              -rho_n[c] * w.row(i);
-          da[i] += 1.0;
-          dp += mu[c] * unit * da;
+          // da = E_n^T - rho_n W_n: the row -rho_n W_n plus 1 in column i (added as a column
+          // of dp, not to a temporary row, which gcc takes for uninitialized).
+          dp -= (mu[c] * rho_n[c]) * unit * w.row(i);
+          dp.col(i) += mu[c] * unit;
         }
       }
       j.middleRows<2>(i + 1) = -dp;
