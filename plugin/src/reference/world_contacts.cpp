@@ -132,8 +132,9 @@ void problemStage(StepContext& c) {
 }
 
 // The initial impulses: for each contact, the world-frame impulse of the nearest unclaimed
-// contact of the same geom pair in the last step within Settings::warm_start_distance,
-// expressed in the new frame (n, t1, t2); zero otherwise. Writes c.gamma.
+// contact of the same geom pair in the last step within Settings::warm_start_distance, else of
+// the pair's contact at the same index in dCollide's list, expressed in the new frame
+// (n, t1, t2); zero otherwise. Writes c.gamma.
 void warmStartStage(StepContext& c) {
   WorldState& s = c.s;
   c.gamma = Eigen::VectorXd::Zero(3 * c.nc);
@@ -155,6 +156,13 @@ void warmStartStage(StepContext& c) {
       if (distance <= best_distance) {
         best_distance = distance;
         best = k;
+      }
+    }
+    if (best == last.size()) {
+      // No contact of the pair within the distance (e.g. a part sliding faster than
+      // warm_start_distance / h): the one at the same place in dCollide's list, if unclaimed.
+      for (std::size_t k = 0; k < last.size(); ++k) {
+        if (last[k].index == raw.index && !s.warm_claimed[claim->second + k]) best = k;
       }
     }
     if (best == last.size()) continue;
@@ -229,8 +237,8 @@ void recordStage(StepContext& c) {
     const WorldState::RawContact& raw = s.raw[static_cast<std::size_t>(i)];
     const Matrix3d& f = c.frames[static_cast<std::size_t>(i)];
     s.warm[{raw.g1, raw.g2}].push_back(
-        {raw.p,
-         f.col(0) * gamma(3 * i) + f.col(1) * gamma(3 * i + 1) + f.col(2) * gamma(3 * i + 2)});
+        {raw.p, f.col(0) * gamma(3 * i) + f.col(1) * gamma(3 * i + 1) + f.col(2) * gamma(3 * i + 2),
+         raw.index});
     ContactImpulse& ci = c.out[static_cast<std::size_t>(i)];
     ci.g1 = raw.g1;
     ci.g2 = raw.g2;

@@ -148,6 +148,7 @@ struct WorldState {
   struct WarmContact {
     Vector3d position;
     Vector3d impulse;
+    int index;  // position among the pair's contacts (RawContact::index)
   };
   std::map<std::pair<dGeomID, dGeomID>, std::vector<WarmContact>> warm;
   std::vector<char> warm_claimed;  // scratch of warmStartStage

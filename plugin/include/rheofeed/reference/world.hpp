@@ -137,7 +137,9 @@ struct Settings {
   double bounce_velocity = 0.0;
   /// Start each step's solve from the last step's impulses: a contact takes the impulse
   /// (world frame, re-expressed in its new contact frame) of the nearest unclaimed contact of
-  /// the same geom pair in the last step, if that lies within warm_start_distance.
+  /// the same geom pair in the last step, if that lies within warm_start_distance, else the
+  /// pair's contact at the same index in dCollide's list (a part sliding faster than
+  /// warm_start_distance / h keeps its corners' impulses).
   bool warm_start = true;
   /// Largest distance (m, finite, >= 0) between a contact point and last step's contact point of
   /// the same geom pair for the warm start to match them (parts move ~|v| h per step).
