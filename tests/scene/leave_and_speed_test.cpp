@@ -202,7 +202,7 @@ TEST(LeftTheFeeder, SlowTurntableKeepsItsCubesAndCountsNothing) {
 // A feeder of two plates with a 3 cm gap between them (x = 0 to 0.03 m), carrying 1 cm cubes
 // along +x at 0.2 m/s; a catch floor 0.3 m below. A cube drops through the gap onto the floor,
 // under the feeder (the gap is narrower than the footprint's growth of 2 bounding radii, 1.7 cm
-// on either side): counted by the rule "under the feeder, on a fixture that did not carry it".
+// on either side): counted by the rule "below the bottom of every carrier over it".
 TEST(LeftTheFeeder, CubeFallingThroughAGapOntoAFloorUnderTheFeederIsCounted) {
   Scene s;
   s.name = "gap";
