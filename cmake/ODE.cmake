@@ -1,6 +1,10 @@
 # SPDX-License-Identifier: MIT
 # Wraps Debian's ODE (libode-dev ships pkg-config metadata only, no CMake package) in the
-# imported target ODE::ODE and refuses a single-precision build.
+# imported target ODE::ODE and refuses a single-precision build. When ODE::ODE exists already
+# (rheofeed's own build with RHEOFEED_ODE=patched: cmake/PatchedODE.cmake) only the probe runs.
+# The probe also tells whether the library has rheofeed's friction-cone patch: it sets
+# RHEOFEED_ODE_HAS_FRICTION_CONE (dCheckConfiguration("ODE_EXT_friction_cone")) and
+# RHEOFEED_ODE_CONFIGURATION (dGetConfiguration()).
 #
 # Used by rheofeed's own build and by the installed rheofeedConfig.cmake, so it must work in any
 # consumer project: C only, C++ only, or both (the precision probe is compiled in whichever of
@@ -40,7 +44,13 @@ function(_rheofeed_wrap_ode)
   # Configure-time precision check: the headers must select dDOUBLE and the library itself must
   # report "ODE_double_precision" from dCheckConfiguration(). The same source is valid C and
   # C++, so it is compiled as whichever language the project enabled.
-  if(RHEOFEED_ODE_IS_DOUBLE)
+  # The probe's outcome is cached per ODE (patched or system): switching RHEOFEED_ODE in a build
+  # tree probes again.
+  set(probe_key "${RHEOFEED_ODE}")
+  if(NOT probe_key)
+    set(probe_key "system")
+  endif()
+  if(RHEOFEED_ODE_IS_DOUBLE AND RHEOFEED_ODE_PROBE_KEY STREQUAL probe_key)
     set(RHEOFEED_ODE_FOUND TRUE PARENT_SCOPE)
     return()
   endif()
@@ -101,6 +111,13 @@ int main(void) {
     message(STATUS "ODE ${RHEOFEED_ODE_PC_VERSION}: ${run_out}")
   endif()
   set(RHEOFEED_ODE_IS_DOUBLE TRUE CACHE INTERNAL "ODE reports double precision")
+  set(RHEOFEED_ODE_PROBE_KEY "${probe_key}" CACHE INTERNAL "which ODE the probe ran on")
+  set(RHEOFEED_ODE_CONFIGURATION "${run_out}" CACHE INTERNAL "dGetConfiguration() of ODE")
+  if(" ${run_out} " MATCHES " ODE_EXT_friction_cone ")
+    set(RHEOFEED_ODE_HAS_FRICTION_CONE TRUE CACHE INTERNAL "ODE has dContactFrictionCone")
+  else()
+    set(RHEOFEED_ODE_HAS_FRICTION_CONE FALSE CACHE INTERNAL "ODE has dContactFrictionCone")
+  endif()
   set(RHEOFEED_ODE_FOUND TRUE PARENT_SCOPE)
 endfunction()
 

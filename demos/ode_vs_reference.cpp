@@ -5,7 +5,7 @@
 // both runs, their differences, the analytic expectation where one exists, and what explains a
 // difference.
 //
-//   ode_vs_reference [--out out/ode_vs_reference] [--pile 50]
+//   ode_vs_reference [--out out/ode_vs_reference] [--pile 50] [--friction cone|pyramid]
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -52,8 +52,8 @@ std::vector<Case> cases(int pile) {
     e << "tan(theta) = 0.613 > mu: slides down at a = g (sin - mu cos) = " << a
       << " m/s^2, |v| = " << a * s.duration << " m/s at t = " << s.duration << " s";
     out.push_back({s, e.str(),
-                   "sliding along fdir1 = belt direction, where ODE's friction pyramid is exact, "
-                   "so it matches the cone; the reference solves true Coulomb (the relaxed CCP, "
+                   "sliding along fdir1 = belt direction, where even ODE's friction pyramid is "
+                   "exact, so both models match the cone; the reference solves true Coulomb (the relaxed CCP, "
                    "coulomb_iterations = 0, would launch the part at u_n = mu |u_t|)"});
   }
   {
@@ -64,8 +64,9 @@ std::vector<Case> cases(int pile) {
   {
     Scene s = helicalRampScene(1.0);
     out.push_back({s, "climbs: w agrees with the helix's handedness",
-                   "partial sliding on tilted segments and across the seams between them: "
-                   "ODE's pyramid vs the cone off the drive direction"});
+                   "partial sliding on tilted segments and across the seams between them "
+                   "(quickstep's iterations; with --friction pyramid also the pyramid's extra "
+                   "grip off the drive direction)"});
   }
   {
     Scene s = helicalRampScene(-1.0);
@@ -94,6 +95,11 @@ int main(int argc, char** argv) {
   CLI::App app{"ODE + rheofeed plugin vs the reference CCP solver on small rheonomic scenes"};
   app.add_option("--out", out_dir, "output folder");
   app.add_option("--pile", pile, "boxes in the pile scene")->check(CLI::Range(1, 2000));
+  std::string friction;
+  app.add_option("--friction", friction,
+                 "ODE's friction model, cone or pyramid (solver.friction; default: the scenes' "
+                 "own, the cone where the linked ODE has it)")
+      ->check(CLI::IsMember({"cone", "pyramid"}));
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -105,7 +111,12 @@ int main(int argc, char** argv) {
            "rel_djn,ode_mean_z,ref_mean_z,ode_cpu_s,ref_cpu_s\n";
     const std::vector<Case> all = cases(pile);
     for (std::size_t i = 0; i < all.size(); ++i) {
-      const Case& c = all[i];
+      Case c = all[i];
+      if (!friction.empty()) {
+        FrictionModel model = FrictionModel::Cone;
+        parseFrictionModel(friction.c_str(), model);  // checked by CLI::IsMember
+        c.scene.solver.friction = model;
+      }
       std::fprintf(stderr, "[%zu/%zu] %s ...\n", i + 1, all.size(), c.scene.name.c_str());
       const Comparison r = compare(c.scene, Method::OdeRheonomic, Method::ReferenceRheonomic);
       char row[512];

@@ -30,7 +30,7 @@
 
 #include <ode/ode.h>
 
-#include "rheofeed/reference/world.hpp"
+#include "rheofeed/reference/contact_problem.hpp"
 
 namespace {
 
@@ -125,7 +125,7 @@ Problem pileProblem(int boxes) {
     world.attachGeom(dCreateBox(world.space(), 0.1, 0.1, 0.1), body);
   }
   for (int step = 0; step < 60; ++step) world.step(0.01);
-  return world.lastProblem();
+  return rheofeed::reference::lastContactProblem(world);
 }
 
 }  // namespace

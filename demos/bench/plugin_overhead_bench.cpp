@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/box_pile.hpp"
 #include "rheofeed/feeder_set.hpp"
 
 namespace {
@@ -38,7 +39,6 @@ namespace {
 using rheofeed::FeederSet;
 using rheofeed::MotionLaw;
 
-constexpr int kMaxContacts = 8;
 constexpr double kStep = 0.005;    // s
 constexpr int kSettleSteps = 100;  // untimed steps before timing: the pile is in contact
 constexpr int kTimedSteps = 200;   // steps per repetition
@@ -48,74 +48,23 @@ int g_boxes = 400;
 enum class Variant { Plain, PluginNoFeederContacts, PluginGroundIsFeeder };
 
 struct Pile {
-  dWorldID world;
-  dSpaceID space;
-  dJointGroupID group;
-  dGeomID ground;
-  dGeomID far_feeder;
+  rheofeed::demo::BoxPile pile;
   std::unique_ptr<FeederSet> feeders;
-  Variant variant;
 
-  explicit Pile(Variant v) : variant(v) {
-    world = dWorldCreate();
-    dWorldSetGravity(world, 0, 0, -9.81);
-    dWorldSetQuickStepNumIterations(world, 20);
-    space = dHashSpaceCreate(nullptr);
-    group = dJointGroupCreate(0);
-    ground = dCreateBox(space, 10, 10, 0.2);
-    dGeomSetPosition(ground, 0, 0, -0.1);
-    far_feeder = dCreateBox(space, 1, 1, 0.1);
+  explicit Pile(Variant v) : pile(g_boxes, dContactApprox1) {
+    dGeomID far_feeder = dCreateBox(pile.space(), 1, 1, 0.1);
     dGeomSetPosition(far_feeder, 100, 100, 0);
-    const int side = 10;
-    for (int i = 0; i < g_boxes; ++i) {
-      const int layer = i / (side * side), k = i % (side * side);
-      dBodyID b = dBodyCreate(world);
-      dMass m;
-      dMassSetBoxTotal(&m, 0.1, 0.1, 0.1, 0.1);
-      dBodySetMass(b, &m);
-      dBodySetPosition(b, (k % side) * 0.12 + 0.01 * (layer % 2), (k / side) * 0.12,
-                       0.06 + layer * 0.11);
-      dGeomSetBody(dCreateBox(space, 0.1, 0.1, 0.1), b);
-    }
     if (v != Variant::Plain) {
       feeders = std::make_unique<FeederSet>();
       feeders->add(far_feeder, MotionLaw::belt({1, 0, 0}, 0.2));
       if (v == Variant::PluginGroundIsFeeder) {
-        feeders->add(ground, MotionLaw::belt({1, 0, 0}, 0.2));
+        feeders->add(pile.ground(), MotionLaw::belt({1, 0, 0}, 0.2));
       }
+      pile.setFeeders(feeders.get());
     }
     for (int i = 0; i < kSettleSteps; ++i) step();
   }
-  ~Pile() {
-    dJointGroupDestroy(group);
-    dSpaceDestroy(space);
-    dWorldDestroy(world);
-  }
-
-  static void nearCallback(void* data, dGeomID o1, dGeomID o2) {
-    auto* self = static_cast<Pile*>(data);
-    dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
-    dContact contact[kMaxContacts];
-    int n = dCollide(o1, o2, kMaxContacts, &contact[0].geom, sizeof(dContact));
-    for (int i = 0; i < n; ++i) {
-      contact[i].surface.mode = dContactApprox1;
-      contact[i].surface.mu = 0.5;
-    }
-    if (self->feeders) n = self->feeders->driveContacts(contact, n);
-    for (int i = 0; i < n; ++i) {
-      dJointID c = dJointCreateContact(self->world, self->group, contact + i);
-      dJointAttach(c, b1, b2);
-    }
-  }
-
-  double time = 0;
-  void step() {
-    if (feeders) feeders->beginStep(time);
-    dSpaceCollide(space, this, &nearCallback);
-    dWorldQuickStep(world, kStep);
-    dJointGroupEmpty(group);
-    time += kStep;
-  }
+  void step() { pile.step(kStep); }
 };
 
 void BM_PileStep(benchmark::State& state) {

@@ -4,6 +4,7 @@
 #include <exception>
 
 #include "cli/commands.hpp"
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/simulation/check.hpp"
 
 namespace rheofeed::cli {
@@ -31,8 +32,8 @@ int checkCommand(const SceneArgs& args) {
   for (const PlannedRun& run : plan.runs) {
     const std::vector<Hazard> found = checkScene(run.scene, run.method);
     std::printf("%s at h = %s s (%s): %zu hazard%s\n", toString(run.method),
-                number(run.scene.solver.time_step).c_str(), run.step_source.c_str(), found.size(),
-                found.size() == 1 ? "" : "s");
+                formatNumber(run.scene.solver.time_step).c_str(), run.step_source.c_str(),
+                found.size(), found.size() == 1 ? "" : "s");
     std::fputs(formatHazards(found, "  ").c_str(), stdout);
     hazards += static_cast<int>(found.size());
   }

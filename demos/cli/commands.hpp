@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "rheofeed/measure/calibration.hpp"
 #include "cli/run_plan.hpp"
@@ -52,6 +53,38 @@ struct StudyArgs {
   bool quick = false;
 };
 int studyCommand(const StudyArgs& args);
+
+/// `rheofeed sweep SPEC`: checks the sweep spec, writes the sweep folder and runs its unfinished
+/// jobs with a backend (local, parallel) or writes (and with `submit` submits) the Slurm scripts;
+/// then collects (sweep.hpp). Exit code 0 when every job has finished, 1 when some failed, 2 for
+/// a bad spec or command line (nothing run), 130 when interrupted.
+struct SweepArgs {
+  std::string spec;
+  std::string backend = "local";  ///< local, parallel or slurm
+  int jobs = 0;                   ///< jobs at a time (local, parallel); 0: the available cores
+  std::string out;                ///< sweep folder (out_given); else out/<spec name>
+  bool out_given = false;
+  std::string sshlogin;   ///< parallel: GNU parallel's --sshlogin
+  int jobs_per_task = 0;  ///< slurm: jobs per array task; 0: the spec's (default 1)
+  bool submit = false;    ///< slurm: submit with sbatch
+  bool check = false;     ///< check the spec and list the jobs, write nothing
+};
+int sweepCommand(const SweepArgs& args);
+
+/// `rheofeed sweep job DIR ID...` (or `--tasks FILE --task K`, a Slurm array task): runs jobs of
+/// a sweep folder, each unless it has finished. Exit code 0, 1 when a job failed, 2 for bad
+/// input, 130/143 when interrupted.
+struct SweepJobArgs {
+  std::string dir;
+  std::vector<std::string> ids;
+  std::string tasks;
+  int task = -1;
+};
+int sweepJobCommand(const SweepJobArgs& args);
+
+/// `rheofeed sweep collect DIR`: the CSV and plots of a sweep folder (exit code 1 when jobs are
+/// unfinished, after writing what there is).
+int sweepCollectCommand(const std::string& dir);
 
 /// Runs the part of `command` ("rheofeed run", ...) that comes after its input was checked and
 /// returns the exit code: 0, or with a message on stderr 2 for a std::invalid_argument (bad input

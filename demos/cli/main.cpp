@@ -5,6 +5,8 @@
 //   rheofeed calibrate SCENE  calibrate the vibrating feeders, write the scene with the result
 //   rheofeed check SCENE      validate the scene and print the hazards of the scene check
 //   rheofeed study SCENE      the error-vs-cost study (rheonomic vs full vibration)
+//   rheofeed sweep SPEC       a design sweep (sweep.hpp): its jobs on this machine's cores, with
+//                             GNU parallel or on Slurm; `sweep collect DIR` gathers the results
 // SCENE is the name of a shipped scene (demos/scenes, installed in share/rheofeed/scenes; see
 // shipped_scenes.hpp) or a scene file. Exit codes: 0 success, 1 a failure while running (check:
 // the scene has hazards), 2 bad input (command line or scene; nothing has run).
@@ -145,8 +147,59 @@ int main(int argc, char** argv) {
   study_cmd->add_flag("--quick", study.quick, "coarser sweeps and a shorter reference")
       ->default_str("off");
 
+  SweepArgs sweep;
+  SweepJobArgs sweep_job;
+  std::string collect_dir;
+  CLI::App* sweep_cmd = app.add_subcommand(
+      "sweep",
+      "a design sweep over a scene (spec format: demos/sweeps/README.md): one `rheofeed run` per "
+      "point and seed, on this machine's cores (local), with GNU parallel (parallel) or as a "
+      "Slurm job array (slurm), then `sweep collect`");
+  sweep_cmd->add_option("SPEC", sweep.spec, "the sweep spec (.json)");
+  sweep_cmd->add_option("--backend", sweep.backend, "local, parallel or slurm")
+      ->capture_default_str();
+  sweep_cmd->add_option("--jobs", sweep.jobs, "jobs at a time (local, parallel), 1 to 1024")
+      ->default_str("the available cores")
+      ->check(CLI::Range(1, 1024));
+  sweep_cmd
+      ->add_option("--out", sweep.out,
+                   "the sweep folder (a folder of an earlier run of "
+                   "the same spec is resumed)")
+      ->default_str("out/<spec name>")
+      ->each([&sweep](const std::string&) { sweep.out_given = true; });
+  sweep_cmd
+      ->add_option("--sshlogin", sweep.sshlogin,
+                   "parallel: GNU parallel's --sshlogin (e.g. 8/node1,8/node2,: for two "
+                   "hosts and this one; DIR and rheofeed at the same paths on every host)")
+      ->default_str("this machine only");
+  sweep_cmd
+      ->add_option("--jobs-per-task", sweep.jobs_per_task,
+                   "slurm: jobs run one after the other by one array task (batch short jobs)")
+      ->default_str("the spec's slurm.jobs_per_task, else 1")
+      ->check(CLI::Range(1, 100000));
+  sweep_cmd->add_flag("--submit", sweep.submit, "slurm: submit the scripts with sbatch")
+      ->default_str("off: write them");
+  sweep_cmd->add_flag("--check", sweep.check, "check the spec and list the jobs; write nothing")
+      ->default_str("off");
+  CLI::App* job_cmd = sweep_cmd->add_subcommand(
+      "job",
+      "run jobs of a sweep folder (what every backend runs; a finished job is not run "
+      "again)");
+  job_cmd->add_option("DIR", sweep_job.dir, "the sweep folder")->required();
+  job_cmd->add_option("ID", sweep_job.ids, "job ids (e.g. 0007)");
+  job_cmd->add_option("--tasks", sweep_job.tasks, "a Slurm task file (one line of ids per task)");
+  job_cmd->add_option("--task", sweep_job.task, "the line of --tasks to run (0-based)");
+  CLI::App* collect_cmd = sweep_cmd->add_subcommand(
+      "collect",
+      "write DIR/results: sweep.csv (means and 95 % intervals over the seeds), "
+      "jobs.csv, plots; list the unfinished jobs");
+  collect_cmd->add_option("DIR", collect_dir, "the sweep folder")->required();
+
   try {
     app.parse(argc, argv);
+    if (sweep_cmd->parsed() && !job_cmd->parsed() && !collect_cmd->parsed() && sweep.spec.empty()) {
+      throw CLI::RequiredError("SPEC (or a subcommand: job, collect)");
+    }
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;  // --help and --version: 0; any bad command line: 2
@@ -156,5 +209,8 @@ int main(int argc, char** argv) {
   if (cal_cmd->parsed()) return calibrateCommand(cal);
   if (check_cmd->parsed()) return checkCommand(check);
   if (study_cmd->parsed()) return studyCommand(study);
+  if (job_cmd->parsed()) return sweepJobCommand(sweep_job);
+  if (collect_cmd->parsed()) return sweepCollectCommand(collect_dir);
+  if (sweep_cmd->parsed()) return sweepCommand(sweep);
   return 2;
 }

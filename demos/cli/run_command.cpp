@@ -11,11 +11,12 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/output/animation.hpp"
 #include "rheofeed/output/output.hpp"
-#include "rheofeed/simulation/check.hpp"
-#include "rheofeed/measure/metrics.hpp"
 #include "rheofeed/output/plot.hpp"
+#include "rheofeed/simulation/check.hpp"
 
 namespace rheofeed::cli {
 
@@ -134,8 +135,8 @@ int runCommand(const RunArgs& args) {
       s.solver = run.scene.solver;
       s.outputs.sample_interval = run.scene.outputs.sample_interval;
       std::fprintf(stderr, "rheofeed run: %s runs at h = %s s (%s), %s s simulated\n", toString(m),
-                   number(s.solver.time_step).c_str(), run.step_source.c_str(),
-                   number(s.duration).c_str());
+                   formatNumber(s.solver.time_step).c_str(), run.step_source.c_str(),
+                   formatNumber(s.duration).c_str());
       std::unique_ptr<AnimationRecorder> recorder;
       if (args.animation && k == 0) recorder = std::make_unique<AnimationRecorder>(s, m);
       const std::vector<std::string> hazards = reportSceneCheck(s, m);

@@ -10,6 +10,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/shipped_scenes.hpp"
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 
 namespace rheofeed::cli {
@@ -23,18 +24,12 @@ constexpr Method kMethods[] = {Method::OdeRheonomic, Method::OdeFullVibration,
 
 void requirePositiveFinite(const std::string& option, double value) {
   if (!(value > 0) || !std::isfinite(value)) {
-    throw std::invalid_argument(option + " = " + number(value) +
+    throw std::invalid_argument(option + " = " + formatNumber(value) +
                                 " s: must be a finite number > 0 (s)");
   }
 }
 
 }  // namespace
-
-std::string number(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
 
 std::string methodNames() {
   std::string names;
@@ -71,7 +66,7 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
   }
   if (args.duration_given) requirePositiveFinite("--duration", args.duration);
   if (args.warmup_given && !(std::isfinite(args.warmup) && args.warmup >= 0)) {
-    throw std::invalid_argument("--warmup = " + number(args.warmup) +
+    throw std::invalid_argument("--warmup = " + formatNumber(args.warmup) +
                                 " s: must be a finite number >= 0 s (and below the duration)");
   }
   if (!args.drift_model.empty()) {
@@ -89,8 +84,9 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
   if (!args.drift_model.empty()) overrideDriftModel(scene, parseDriftModelOption(args.drift_model));
   const std::string where =
       "scene " + plan.file.string() +
-      (args.duration_given ? " with --duration " + number(args.duration) + " s" : std::string()) +
-      (args.warmup_given ? " with --warmup " + number(args.warmup) + " s" : std::string());
+      (args.duration_given ? " with --duration " + formatNumber(args.duration) + " s"
+                           : std::string()) +
+      (args.warmup_given ? " with --warmup " + formatNumber(args.warmup) + " s" : std::string());
   try {
     scene.validate();
   } catch (const std::invalid_argument& e) {
@@ -121,8 +117,9 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
     try {
       run.scene.validate();
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string("method ") + toString(m) + " at h = " + number(h) +
-                                  " s (" + run.step_source + "), " + where + ": " + e.what());
+      throw std::invalid_argument(std::string("method ") + toString(m) +
+                                  " at h = " + formatNumber(h) + " s (" + run.step_source + "), " +
+                                  where + ": " + e.what());
     }
     plan.runs.push_back(std::move(run));
   }

@@ -70,7 +70,4 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
 /// std::invalid_argument naming it (and `option`, e.g. "--out") when it cannot.
 void prepareOutputFolder(const std::filesystem::path& folder, const std::string& option);
 
-/// A number as a user would type it ("1e-12", not "0.000000").
-std::string number(double value);
-
 }  // namespace rheofeed::cli

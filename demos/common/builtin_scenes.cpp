@@ -6,8 +6,6 @@
 namespace rheofeed::scene {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 Fixture boxFixture(const std::string& name, const Vec3& size, const Pose& pose) {
   Fixture f;
   f.name = name;
@@ -276,6 +274,20 @@ Scene linearTroughScene(int count, double rate, double amplitude, double frequen
   s.outputs.exit_plane = true;
   s.outputs.exit_point = {0.6, 0, 0};
   s.outputs.exit_normal = {1, 0, 0};
+  return s;
+}
+
+Scene tiltedTrackScene(double incline_deg, double cross_deg, bool sideways, bool quick) {
+  constexpr double kDeg = 3.14159265358979323846 / 180;
+  Scene s = vibratingTrackScene(0.2e-3, 50, 20 * kDeg, 1);
+  const double a = incline_deg * kDeg, c = cross_deg * kDeg;
+  s.gravity = {-9.81 * std::sin(a), -9.81 * std::cos(a) * std::sin(c),
+               -9.81 * std::cos(a) * std::cos(c)};
+  s.name = "track";
+  s.parts[0].spawn_min = s.parts[0].spawn_max = {-0.2, 0, 0.0025};
+  s.duration = quick ? 1.5 : 4.0;
+  s.outputs.warmup = quick ? 0.5 : 1.0;
+  if (sideways) s.outputs.conveying_direction = {0, 1, 0};
   return s;
 }
 

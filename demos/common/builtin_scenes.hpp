@@ -35,6 +35,14 @@ Scene pileOnBeltScene(int count = 50, double speed = 0.3);
 Scene vibratingTrackScene(double amplitude = 0.2e-3, double frequency = 50, double angle = 0.349066,
                           int parts = 1);
 
+/// A single flat part on the track of vibratingTrackScene (0.2 mm at 20 degrees, 50 Hz, mu 0.4:
+/// throw number 0.69, sliding), with gravity turned so that the track climbs by `incline_deg`
+/// along +x and falls sideways by `cross_deg` towards -y (a turned gravity is the same physics
+/// as a turned track and keeps the part on the same box). 4 s with 1 s warm-up (`quick`: 1.5 s
+/// with 0.5 s); drift measured along +x, or along +y (uphill across) with `sideways`. The
+/// drift-model study's tracks and the friction cone's cross-slope test.
+Scene tiltedTrackScene(double incline_deg, double cross_deg, bool sideways, bool quick);
+
 /// A linear vibratory trough (base 0.7 m x 0.12 m with side walls, along +x, top of the base at
 /// z = 0) fed by a hopper at its start: boxes with normally distributed sizes (mean 15 mm,
 /// 15 % spread) spawned at `rate` parts/s up to `count`; the trough vibrates at `frequency`

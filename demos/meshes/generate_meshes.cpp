@@ -25,9 +25,11 @@
 #include <string>
 #include <vector>
 
+#include "rheofeed/vec3.hpp"
+
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using rheofeed::kPi;
 
 struct Mesh {
   std::vector<std::array<double, 3>> vertices;

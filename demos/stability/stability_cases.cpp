@@ -13,13 +13,13 @@
 #include "common/builtin_scenes.hpp"
 #include "rheofeed/measure/calibration.hpp"
 #include "rheofeed/measure/classical_model.hpp"
+#include "rheofeed/number_format.hpp"
 
 namespace rheofeed::stability {
 namespace {
 
 using namespace rheofeed::scene;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 /// Vertical gap (m) between a spawned part and what is under it.
@@ -278,20 +278,14 @@ class Builder {
   std::vector<std::pair<Vec3, double>> placed_;
 };
 
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 // --- Mass ratios -------------------------------------------------------------------------------
 
 /// Four 1 cm cubes (1 g) under a 10 x 10 x 5 cm box of mass 1 g x ratio.
 StabilityCase lightUnderHeavy(double ratio, double h, bool dantzig) {
-  std::string name = "light_under_heavy_r" + num(ratio);
-  if (h != 0.01) name += "_h" + num(h);
+  std::string name = "light_under_heavy_r" + formatNumber(ratio);
+  if (h != 0.01) name += "_h" + formatNumber(h);
   if (dantzig) name += "_dantzig";
-  Builder b(name, "mass ratio " + num(ratio) + " in contact: 1 g cubes under a heavy box");
+  Builder b(name, "mass ratio " + formatNumber(ratio) + " in contact: 1 g cubes under a heavy box");
   b.floor(1, 1);
   for (double x : {-0.035, 0.035}) {
     for (double y : {-0.035, 0.035}) b.boxAt({0.01, 0.01, 0.01}, 1e-3, x, y, kGap);
@@ -305,8 +299,8 @@ StabilityCase lightUnderHeavy(double ratio, double h, bool dantzig) {
 
 /// A 1 g cube on a box of mass 1 g x ratio.
 StabilityCase heavyUnderLight(double ratio) {
-  Builder b("heavy_under_light_r" + num(ratio),
-            "mass ratio " + num(ratio) + " in contact: a 1 g cube on a heavy box");
+  Builder b("heavy_under_light_r" + formatNumber(ratio),
+            "mass ratio " + formatNumber(ratio) + " in contact: a 1 g cube on a heavy box");
   b.floor(1, 1);
   b.boxAt({0.1, 0.1, 0.05}, 1e-3 * ratio, 0, 0, kGap);
   b.boxAt({0.01, 0.01, 0.01}, 1e-3, 0.02, 0.01, 0.05 + kGap);
@@ -315,8 +309,9 @@ StabilityCase heavyUnderLight(double ratio) {
 
 /// A belt at 0.5 m/s pushes a heavy box (1 g x ratio) against a 1 g cube held by a wall.
 StabilityCase squeezedAgainstWall(double ratio) {
-  Builder b("squeezed_wall_r" + num(ratio),
-            "mass ratio " + num(ratio) + ": 1 g cube squeezed between a wall and a heavy box");
+  Builder b(
+      "squeezed_wall_r" + formatNumber(ratio),
+      "mass ratio " + formatNumber(ratio) + ": 1 g cube squeezed between a wall and a heavy box");
   b.belt(0.5, 1.0, 0.4);
   b.endWall(-1, 0.2, 0.3, 0.0, 0.1);
   b.boxAt({0.01, 0.01, 0.01}, 1e-3, 0.2 - 0.0055, 0, kGap);
@@ -329,12 +324,14 @@ StabilityCase squeezedAgainstWall(double ratio) {
 std::vector<StabilityCase> sizeCases() {
   std::vector<StabilityCase> out;
   for (double h : {0.01, 0.001}) {
-    Builder b("cube_1mm_h" + num(h), "1 mm steel cubes dropped 2 mm, h = " + num(h) + " s");
+    Builder b("cube_1mm_h" + formatNumber(h),
+              "1 mm steel cubes dropped 2 mm, h = " + formatNumber(h) + " s");
     b.floor(0.2, 0.2);
     b.parts(Shape::Kind::Box, {1e-3, 1e-3, 1e-3}, 7800, 10, {-0.02, -0.02, 0.002},
             {0.02, 0.02, 0.004}, true);
     b.scene().solver.time_step = h;
-    b.kase().note = "h v at landing = " + num(h * std::sqrt(2 * kG * 0.004)) + " m vs 1 mm part";
+    b.kase().note =
+        "h v at landing = " + formatNumber(h * std::sqrt(2 * kG * 0.004)) + " m vs 1 mm part";
     out.push_back(b.finish());
   }
   {
@@ -409,7 +406,8 @@ std::vector<StabilityCase> sizeCases() {
 // --- Time steps --------------------------------------------------------------------------------
 
 StabilityCase beltStep(double h) {
-  Builder b("belt_h" + num(h), "rheonomic h = " + num(h) + " s: boxes dropped on a 0.5 m/s belt");
+  Builder b("belt_h" + formatNumber(h),
+            "rheonomic h = " + formatNumber(h) + " s: boxes dropped on a 0.5 m/s belt");
   b.belt(0.5, 2.0, 0.4);
   b.parts(Shape::Kind::Box, {0.02, 0.02, 0.02}, 1000, 10, {-0.8, -0.15, 0.02}, {-0.5, 0.15, 0.05},
           true);
@@ -419,13 +417,14 @@ StabilityCase beltStep(double h) {
 }
 
 StabilityCase tunnelDrop(double h) {
-  Builder b("drop_0p5m_h" + num(h), "2 cm boxes dropped 0.5 m on a 1 cm floor, h = " + num(h));
+  Builder b("drop_0p5m_h" + formatNumber(h),
+            "2 cm boxes dropped 0.5 m on a 1 cm floor, h = " + formatNumber(h));
   b.floor(1, 1, 0.01);
   b.parts(Shape::Kind::Box, {0.02, 0.02, 0.02}, 1000, 20, {-0.3, -0.3, 0.45}, {0.3, 0.3, 0.5},
           true);
   b.scene().solver.time_step = h;
   const double v = std::sqrt(2 * kG * 0.5);
-  b.kase().note = "h v at landing = " + num(h * v) + " m vs floor 0.01 m + part 0.02 m";
+  b.kase().note = "h v at landing = " + formatNumber(h * v) + " m vs floor 0.01 m + part 0.02 m";
   return b.finish();
 }
 
@@ -449,10 +448,11 @@ StabilityCase track(const std::string& name, const std::string& covers, double f
 // --- Belts, turntables -------------------------------------------------------------------------
 
 StabilityCase beltSpeed(double speed, double h, bool lone, double mu = 0.5) {
-  std::string name = (lone ? "belt_lone_box_" : "belt_") + num(speed) + "mps";
-  if (h != 0.01) name += "_h" + num(h);
-  if (mu != 0.5) name += "_mu" + num(mu);
-  Builder b(name, "belt " + num(speed) + " m/s, mu " + num(mu) + ", h " + num(h));
+  std::string name = (lone ? "belt_lone_box_" : "belt_") + formatNumber(speed) + "mps";
+  if (h != 0.01) name += "_h" + formatNumber(h);
+  if (mu != 0.5) name += "_mu" + formatNumber(mu);
+  Builder b(name, "belt " + formatNumber(speed) + " m/s, mu " + formatNumber(mu) + ", h " +
+                      formatNumber(h));
   b.belt(speed, 6.0, 0.4);
   if (lone) {
     b.parts(Shape::Kind::Box, {0.05, 0.05, 0.05}, 1000, 1, {-2.5, 0, 0.025 + kGap},
@@ -467,11 +467,12 @@ StabilityCase beltSpeed(double speed, double h, bool lone, double mu = 0.5) {
 }
 
 StabilityCase turntableCase(double omega, bool rim, double duration) {
-  std::string name = "turntable_" + num(omega) + "rads";
+  std::string name = "turntable_" + formatNumber(omega) + "rads";
   if (rim) name += "_rim";
-  if (duration != 1) name += "_" + num(duration) + "s";
-  Builder b(name, "turntable " + num(omega) + " rad/s (rim speed " + num(omega * 0.3) + " m/s)" +
-                      (rim ? " with a rim" : "") + ", " + num(duration) + " s");
+  if (duration != 1) name += "_" + formatNumber(duration) + "s";
+  Builder b(name, "turntable " + formatNumber(omega) + " rad/s (rim speed " +
+                      formatNumber(omega * 0.3) + " m/s)" + (rim ? " with a rim" : "") + ", " +
+                      formatNumber(duration) + " s");
   b.turntable(omega, 0.3);
   if (rim) b.rim(0.3);
   if (duration > 10) {
@@ -484,7 +485,7 @@ StabilityCase turntableCase(double omega, bool rim, double duration) {
   b.scene().material.mu = 0.8;
   b.scene().duration = duration;
   if (!rim && omega * omega * 0.05 > 0.8 * kG) {
-    b.kase().note = "w^2 r > mu g beyond r = " + num(0.8 * kG / (omega * omega)) +
+    b.kase().note = "w^2 r > mu g beyond r = " + formatNumber(0.8 * kG / (omega * omega)) +
                     " m: parts fly off the table (lost, must be reported)";
   }
   return b.finish();
@@ -518,19 +519,20 @@ std::vector<StabilityCase> stabilityCases() {
   }
   // Frequencies 50 to 500 Hz.
   for (double f : {100.0, 200.0, 500.0}) {
-    add(track("track_" + num(f) + "hz", num(f) + " Hz, throw 1.5, 100 steps per cycle", f, 1.5,
-              100));
+    add(track("track_" + formatNumber(f) + "hz",
+              formatNumber(f) + " Hz, throw 1.5, 100 steps per cycle", f, 1.5, 100));
   }
   add(track("track_500hz_spc20", "500 Hz, throw 1.5, 20 steps per cycle", 500, 1.5, 20));
   // Throw numbers to 6.
   for (double g : {0.5, 1.0, 3.0, 6.0}) {
-    add(track("track_throw" + num(g), "throw number " + num(g) + " at 50 Hz", 50, g, 100));
+    add(track("track_throw" + formatNumber(g), "throw number " + formatNumber(g) + " at 50 Hz", 50,
+              g, 100));
   }
   add(track("track_throw6_500hz", "throw number 6 at 500 Hz", 500, 6, 50));
   // Friction on the track.
   for (double mu : {0.0, 0.01, 1.0, 2.0}) {
-    add(track("track_mu" + num(mu), "mu " + num(mu) + " on a 50 Hz track (throw 1.5)", 50, 1.5, 100,
-              mu));
+    add(track("track_mu" + formatNumber(mu),
+              "mu " + formatNumber(mu) + " on a 50 Hz track (throw 1.5)", 50, 1.5, 100, mu));
   }
 
   // Friction and speed on belts.
@@ -542,7 +544,8 @@ std::vector<StabilityCase> stabilityCases() {
 
   // Restitution 0 to 1.
   for (double e : {0.0, 0.5, 1.0}) {
-    Builder b("restitution_" + num(e), "1 cm steel spheres dropped 0.2 m, restitution " + num(e));
+    Builder b("restitution_" + formatNumber(e),
+              "1 cm steel spheres dropped 0.2 m, restitution " + formatNumber(e));
     b.floor(1, 1);
     b.parts(Shape::Kind::Sphere, {0.01, 0, 0}, 7800, 5, {-0.2, -0.2, 0.2}, {0.2, 0.2, 0.2});
     b.scene().material.restitution = e;
@@ -589,7 +592,7 @@ std::vector<StabilityCase> stabilityCases() {
     b.scene().solver.time_step = 0.05;
     b.scene().solver.iterations = 30;
     b.scene().duration = 2;
-    b.kase().note = "h v at landing from 0.3 m = " + num(0.05 * std::sqrt(2 * kG * 0.3)) +
+    b.kase().note = "h v at landing from 0.3 m = " + formatNumber(0.05 * std::sqrt(2 * kG * 0.3)) +
                     " m vs belt 0.1 m + part 0.02 m";
     add(b.finish());
   }

@@ -17,6 +17,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/simulation/check.hpp"
 #include "stability/stability_cases.hpp"
 
@@ -112,6 +113,8 @@ std::pair<Vec3, double> planeAt(const Surface& f, const Scene& scene, bool full_
   return {n, dot(n, d.transform(f.offset * f.normal))};
 }
 
+// Any printf conversion of one double: the report's columns mix significant digits (%.3g) with
+// fixed decimals (%.2f, %.3f), which formatNumber (significant digits only) does not print.
 std::string fmt(double v, const char* format = "%.4g") {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, v);
@@ -429,10 +432,6 @@ std::vector<std::string> splitCsv(const std::string& line) {
   return out;
 }
 
-std::string g17(double v) {
-  return fmt(v, "%.17g");
-}
-
 }  // namespace
 
 std::string csvHeader() {
@@ -447,17 +446,18 @@ std::string csvHeader() {
 std::string csvRow(const RunRecord& r) {
   std::ostringstream o;
   const double share = r.steps > 0 ? double(r.fallback_steps) / double(r.steps) : 0;
-  o << quote(r.case_name) << ',' << quote(r.method) << ',' << g17(r.time_step) << ',' << r.steps
-    << ',' << g17(r.duration) << ',' << r.parts << ',' << r.status << ','
-    << fmt(r.wall_seconds, "%.3f") << ',' << r.nonfinite_parts << ',' << g17(r.max_speed) << ','
-    << g17(r.speed_bound) << ',' << g17(r.energy_budget) << ',' << g17(r.energy_ratio) << ','
-    << g17(r.max_penetration) << ',' << g17(r.penetration_ratio) << ',' << r.lost_measured << ','
-    << r.lost_reported << ',' << r.parts_fell << ',' << r.parts_through_fixture << ','
-    << r.parts_out_of_bounds << ',' << r.parts_nonfinite << ',' << r.parts_too_fast << ','
-    << r.fallback_steps << ',' << g17(share) << ',' << r.unconverged_steps << ','
-    << r.check_warnings << ',' << r.verdict << ',' << quote(r.covers) << ',' << quote(r.message)
-    << ',' << quote(r.lost_how) << ',' << quote(r.ignored_settings) << ',' << quote(r.hazards)
-    << ',' << quote(r.safe_settings) << ',' << quote(r.cause);
+  o << quote(r.case_name) << ',' << quote(r.method) << ',' << formatNumber(r.time_step, 17) << ','
+    << r.steps << ',' << formatNumber(r.duration, 17) << ',' << r.parts << ',' << r.status << ','
+    << fmt(r.wall_seconds, "%.3f") << ',' << r.nonfinite_parts << ','
+    << formatNumber(r.max_speed, 17) << ',' << formatNumber(r.speed_bound, 17) << ','
+    << formatNumber(r.energy_budget, 17) << ',' << formatNumber(r.energy_ratio, 17) << ','
+    << formatNumber(r.max_penetration, 17) << ',' << formatNumber(r.penetration_ratio, 17) << ','
+    << r.lost_measured << ',' << r.lost_reported << ',' << r.parts_fell << ','
+    << r.parts_through_fixture << ',' << r.parts_out_of_bounds << ',' << r.parts_nonfinite << ','
+    << r.parts_too_fast << ',' << r.fallback_steps << ',' << formatNumber(share, 17) << ','
+    << r.unconverged_steps << ',' << r.check_warnings << ',' << r.verdict << ',' << quote(r.covers)
+    << ',' << quote(r.message) << ',' << quote(r.lost_how) << ',' << quote(r.ignored_settings)
+    << ',' << quote(r.hazards) << ',' << quote(r.safe_settings) << ',' << quote(r.cause);
   return o.str();
 }
 

@@ -11,11 +11,11 @@
 #include <stdexcept>
 
 #include "common/builtin_scenes.hpp"
-#include "rheofeed/scene/run_step.hpp"
 #include "rheofeed/measure/calibration.hpp"
 #include "rheofeed/measure/metrics.hpp"
 #include "rheofeed/output/output.hpp"
 #include "rheofeed/output/plot.hpp"
+#include "rheofeed/scene/run_step.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 
 namespace rheofeed::demo {
@@ -23,7 +23,6 @@ namespace {
 
 using namespace rheofeed::scene;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180;
 
 // The drift models of the comparison, in table order.
@@ -48,30 +47,13 @@ struct StudyScene {
   int judge_steps_per_cycle = 0;
 };
 
-// A single flat part on the track of vibratingTrackScene (0.2 mm at 20 degrees, 50 Hz, mu 0.4:
-// throw number 0.69, sliding), with gravity turned so that the track climbs by `incline` along
-// +x and falls sideways by `cross` towards -y (a turned gravity is the same physics as a turned
-// track and keeps the part on the same box).
-Scene tiltedTrack(double incline_deg, double cross_deg, bool sideways, bool quick) {
-  Scene s = vibratingTrackScene(0.2e-3, 50, 20 * kDeg, 1);
-  const double a = incline_deg * kDeg, c = cross_deg * kDeg;
-  s.gravity = {-9.81 * std::sin(a), -9.81 * std::cos(a) * std::sin(c),
-               -9.81 * std::cos(a) * std::cos(c)};
-  s.name = "track";
-  s.parts[0].spawn_min = s.parts[0].spawn_max = {-0.2, 0, 0.0025};
-  s.duration = quick ? 1.5 : 4.0;
-  s.outputs.warmup = quick ? 0.5 : 1.0;
-  if (sideways) s.outputs.conveying_direction = {0, 1, 0};
-  return s;
-}
-
 std::vector<StudyScene> studyScenes(const DriftModelStudyOptions& o) {
   std::vector<StudyScene> list;
   auto track = [&](const std::string& name, const std::string& what, double incline, double cross,
                    bool sideways) {
     list.push_back({name, what,
                     [=](bool quick) {
-                      Scene s = tiltedTrack(incline, cross, sideways, quick);
+                      Scene s = tiltedTrackScene(incline, cross, sideways, quick);
                       s.name = name;
                       return s;
                     },

@@ -119,6 +119,21 @@ void rfFeederSetDestroy(rfFeederSetID set) {
   delete set;
 }
 
+int rfFeederSetSetFrictionModel(rfFeederSetID set, int model) {
+  return guarded(set, [&] {
+    if (model != rfFrictionPyramid && model != rfFrictionCone) {
+      throw std::invalid_argument("rfFeederSetSetFrictionModel: model = " + std::to_string(model) +
+                                  " must be rfFrictionPyramid (0) or rfFrictionCone (1)");
+    }
+    set->set.setFrictionModel(model == rfFrictionCone ? rheofeed::FrictionModel::Cone
+                                                      : rheofeed::FrictionModel::Pyramid);
+  });
+}
+
+int rfOdeHasFrictionCone(void) {
+  return rheofeed::odeHasFrictionCone() ? 1 : 0;
+}
+
 int rfFeederSetAddTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
                         const double angular[3], const double origin[3], int frame) {
   return guarded(set, [&] { set->set.add(geom, twistLaw(linear, angular, origin, frame)); });

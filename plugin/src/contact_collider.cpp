@@ -18,6 +18,9 @@ ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders, const Setti
                                 std::to_string(settings.max_contacts_per_pair) +
                                 " must be in 1..65535");
   }
+  requireFrictionModel(settings.friction, "rheofeed::ContactCollider: Settings::friction");
+  settings_.default_surface.mode =
+      withFrictionModel(settings.default_surface.mode, settings.friction);
   buffer_.resize(static_cast<std::size_t>(settings.max_contacts_per_pair));
   group_ = dJointGroupCreate(0);
 }
@@ -96,6 +99,16 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
   if (n <= 0) return;
   for (int i = 0; i < n; ++i) contacts[i].surface = settings_.default_surface;
   if (surface_ && !surface_(o1, o2, contacts, n)) return;
+  if (!odeHasFrictionCone()) {
+    for (int i = 0; i < n; ++i) {
+      if (contacts[i].surface.mode & kContactFrictionCone) {
+        throw std::invalid_argument(
+            "rheofeed::ContactCollider: the SurfaceCallback set dContactFrictionCone (mode "
+            "bit 0x8000) but the linked ODE has no friction cone (a stock library would "
+            "silently solve the pyramid): clear the bit, or link the patched ODE");
+      }
+    }
+  }
 
   std::vector<ContactRecord>& records = feeders_.records();
   const std::size_t first_record = records.size();

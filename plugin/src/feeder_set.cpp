@@ -37,6 +37,20 @@ std::string geomName(dGeomID geom) {
 
 }  // namespace
 
+bool odeHasFrictionCone() {
+  static const bool has_cone = dCheckConfiguration("ODE_EXT_friction_cone") != 0;
+  return has_cone;
+}
+
+void requireFrictionModel(FrictionModel model, const char* setting) {
+  if (model != FrictionModel::Cone || odeHasFrictionCone()) return;
+  throw std::invalid_argument(
+      std::string(setting) +
+      " = cone needs an ODE with rheofeed's friction-cone patch (patches/0002, "
+      "dCheckConfiguration(\"ODE_EXT_friction_cone\")), but the linked ODE reports \"" +
+      dGetConfiguration() + "\": use pyramid, or link the patched ODE (RHEOFEED_ODE=patched)");
+}
+
 void requireDoublePrecisionOde() {
   static const bool is_double = dCheckConfiguration("ODE_double_precision") != 0;
   if (!is_double) {
@@ -210,6 +224,19 @@ struct FeederSet::Impl {
     return ok;
   }
 
+  // driveContacts' stages (defined below the struct).
+  struct PairCache;
+  struct Sides;
+  struct Velocities;
+  void lookup(const dContact& c, PairCache& pair) const;
+  Sides sides(const dContact& c, const PairCache& pair) const;
+  Velocities surfaceVelocities(const dContact& c, const PairCache& pair, const Sides& sd);
+  bool feederVelocity(Feeder& f, const dContact& c, bool feeder_is_g1, dBodyID other, const Vec3& p,
+                      const Vec3& n, Vec3& value);
+  bool write(dContact& c, Feeder& primary, const Velocities& v);
+  void record(const dContact& c, const PairCache& pair, const Sides& sd, const Velocities& v,
+              bool driven) noexcept;
+
   // Names the first bad value of an invalid contact.
   static std::string contactProblem(const dContact& c) {
     const dContactGeom& g = c.geom;
@@ -240,6 +267,199 @@ struct FeederSet::Impl {
   }
 };
 
+// ---- driveContacts' stages (file comment of feeder_set.hpp for the physics) ----------------
+struct FeederSet::Impl::PairCache {
+  dGeomID g1 = nullptr, g2 = nullptr;
+  Feeder* f1 = nullptr;  // g1's feeder, or null
+  Feeder* f2 = nullptr;  // g2's feeder, or null
+};
+
+// ODE's row order: node0 is the body attached first (Options::attach_order), unless it is 0 and
+// the other is not (ODE swaps them then).
+struct FeederSet::Impl::Sides {
+  dGeomID first, second;
+  dBodyID b_first, b_second;
+  Feeder* f_first;
+  Feeder* f_second;
+};
+
+// Tangential surface velocity of each side's geom at the contact (m/s, world; 0 for a geom that
+// is no feeder); `finite` is false when a law failed (the contact is then left undriven).
+struct FeederSet::Impl::Velocities {
+  Vec3 c_first, c_second;
+  bool finite = true;
+};
+
+// Stage 1, lookup: which of the contact's geoms are feeders (cached while the pair repeats).
+void FeederSet::Impl::lookup(const dContact& c, PairCache& pair) const {
+  if (c.geom.g1 == pair.g1 && c.geom.g2 == pair.g2) return;
+  pair.g1 = c.geom.g1;
+  pair.g2 = c.geom.g2;
+  pair.f1 = find(pair.g1);
+  pair.f2 = find(pair.g2);
+}
+
+FeederSet::Impl::Sides FeederSet::Impl::sides(const dContact& c, const PairCache& pair) const {
+  Sides sd;
+  sd.first = options.attach_order == AttachOrder::G1First ? c.geom.g1 : c.geom.g2;
+  sd.second = sd.first == c.geom.g1 ? c.geom.g2 : c.geom.g1;
+  sd.b_first = bodyOf(sd.first);
+  sd.b_second = bodyOf(sd.second);
+  if (!sd.b_first && sd.b_second) {
+    std::swap(sd.first, sd.second);
+    std::swap(sd.b_first, sd.b_second);
+  }
+  sd.f_first = sd.first == c.geom.g1 ? pair.f1 : pair.f2;
+  sd.f_second = sd.first == c.geom.g1 ? pair.f2 : pair.f1;
+  return sd;
+}
+
+// Stage 2, surface velocity: each feeder's frozen law at the contact (contactSurfaceVelocity,
+// shared with the reference world), checked against the limits; sleeping parts on a feeder
+// whose law changed are woken.
+FeederSet::Impl::Velocities FeederSet::Impl::surfaceVelocities(const dContact& c,
+                                                               const PairCache& pair,
+                                                               const Sides& sd) {
+  const Vec3 p = toVec3(c.geom.pos);
+  const Vec3 n = toVec3(c.geom.normal);
+  Velocities out;
+  for (Feeder* f : {sd.f_first, sd.f_second}) {
+    if (!f) continue;
+    Vec3 value;
+    if (!feederVelocity(*f, c, f == pair.f1, f == sd.f_first ? sd.b_second : sd.b_first, p, n,
+                        value)) {
+      out.finite = false;
+    }
+    (f == sd.f_first ? out.c_first : out.c_second) = value;
+    if (f->changed) {  // the law changed: wake sleeping parts on it
+      wake(sd.b_first, *f);
+      wake(sd.b_second, *f);
+    }
+  }
+  return out;
+}
+
+// One feeder's law at the contact into `value`; false (reported, counted) when the law failed
+// or threw. `feeder_is_g1`: the normal n (ODE's, from g2 into g1) points out of the feeder
+// when it is g2. `other`: the body on the other side of the contact (0 if static).
+bool FeederSet::Impl::feederVelocity(Feeder& f, const dContact& c, bool feeder_is_g1, dBodyID other,
+                                     const Vec3& p, const Vec3& n, Vec3& value) {
+  // User functions (field, twist function, profile) run in here: whatever they throw is caught,
+  // and the contact is left undriven (no exception may unwind into ODE).
+  try {
+    const StepLaw& law = frozen(f);
+    if (!law.finite()) {
+      ++(law.threw() ? f.stats.law_threw : f.stats.law_not_finite);
+      report(f, law.threw() ? DiagnosticKind::LawThrew : DiagnosticKind::LawNotFinite,
+             [&] { return law.problem() + "; contact left undriven"; });
+      value = Vec3{};
+      return false;
+    }
+    Vec3 centre;  // the other body's centre of mass: carried by secant laws, local laws' point
+    const bool carried = other && (law.needsContactSide() || law.usesCarriedPoint());
+    if (carried) centre = toVec3(dBodyGetPosition(other));
+    value = contactSurfaceVelocity(law, p, n, feeder_is_g1 ? -n : n, c.surface.mu,
+                                   law.needsContactSide() ? partEfficiency(other) : 1.0,
+                                   carried ? &centre : nullptr);
+    // Non-finite, or beyond what ODE's motion1 can take (motion_law.hpp, Limits): a NaN
+    // component, or an inf (also from squares of finite components that overflow), fails the
+    // one comparison.
+    if (!(dot(value, value) <= kContactSpeedLimit2)) {
+      ++f.stats.law_not_finite;
+      report(f, DiagnosticKind::LawNotFinite, [&] {
+        std::ostringstream out;
+        out << "law gave surface velocity (" << value.x << ", " << value.y << ", " << value.z
+            << ") m/s at p = (" << p.x << ", " << p.y << ", " << p.z << "), t = " << time
+            << ": not finite or beyond the limit |c_t| <= " << kMaxSurfaceSpeed
+            << " m/s; contact left undriven";
+        return out.str();
+      });
+      return false;
+    }
+    return true;
+  } catch (...) {
+    value = Vec3{};
+    ++f.stats.law_threw;
+    report(f, DiagnosticKind::LawThrew, [&] {
+      std::ostringstream out;
+      out << "law threw at p = (" << p.x << ", " << p.y << ", " << p.z << "), t = " << time << ": "
+          << detail::currentExceptionMessage() << "; contact left undriven";
+      return out.str();
+    });
+    return false;
+  }
+}
+
+// Stage 3, write: the friction mode (Approx1, the friction model) and fdir1 / motion1 along the
+// relative surface velocity c_rel = c_second - c_first (ODE's row: (v_node0 - v_node1) . fdir1 =
+// motion1). Returns whether the contact was driven (|c_rel| above min_surface_speed).
+bool FeederSet::Impl::write(dContact& c, Feeder& primary, const Velocities& v) {
+  dSurfaceParameters& surf = c.surface;
+  if (options.force_approx1) {
+    surf.mode |= dContactApprox1;
+  } else if ((surf.mode & dContactApprox1) == 0 &&
+             !primary.reported[static_cast<int>(DiagnosticKind::ForceCapFriction)]) {
+    report(primary, DiagnosticKind::ForceCapFriction, [&] {
+      return "contact without dContactApprox1: mu = " + std::to_string(surf.mu) +
+             " is a force cap in newtons, not a coefficient";
+    });
+  }
+  surf.mode = withFrictionModel(surf.mode, options.friction);
+  if (surf.mu == 0) {
+    ++primary.stats.zero_friction;
+    report(primary, DiagnosticKind::ZeroFriction, [] {
+      return std::string(
+          "contact mu = 0: ODE applies no friction, so the surface motion has no effect");
+    });
+  }
+  const Vec3 n = toVec3(c.geom.normal);
+  const Vec3 c_rel = tangentialPart(v.c_second - v.c_first, n);
+  const double speed = v.finite ? norm(c_rel) : 0.0;
+  surf.mode &= ~(dContactMotion2);
+  surf.motion2 = 0;
+  const bool driven = speed > options.min_surface_speed;
+  if (!driven) {
+    surf.mode &= ~(dContactFDir1 | dContactMotion1);
+    surf.motion1 = 0;
+  } else {
+    const Vec3 t = (1.0 / speed) * c_rel;
+    c.fdir1[0] = t.x;
+    c.fdir1[1] = t.y;
+    c.fdir1[2] = t.z;
+    c.fdir1[3] = 0;
+    surf.motion1 = speed;
+    surf.mode |= dContactFDir1 | dContactMotion1;
+  }
+  return driven;
+}
+
+// Stage 4, record: the per-feeder counters and, with Options::record_contacts, the contact.
+void FeederSet::Impl::record(const dContact& c, const PairCache& pair, const Sides& sd,
+                             const Velocities& v, bool driven) noexcept {
+  Feeder& primary = pair.f1 ? *pair.f1 : *pair.f2;
+  int FeederStats::*counter =
+      driven ? &FeederStats::contacts_driven : &FeederStats::contacts_undriven;
+  ++(primary.stats.*counter);
+  if (pair.f1 && pair.f2) ++(pair.f2->stats.*counter);
+  if (!options.record_contacts) return;
+  try {
+    const dGeomID g1 = c.geom.g1, g2 = c.geom.g2;
+    const bool feeder_is_g1 = pair.f1 != nullptr;
+    const Vec3 c_g1 = sd.first == g1 ? v.c_first : v.c_second;
+    const Vec3 c_g2 = sd.first == g1 ? v.c_second : v.c_first;
+    ContactRecord r;
+    r.feeder = feeder_is_g1 ? g1 : g2;
+    r.part = feeder_is_g1 ? g2 : g1;
+    r.position = toVec3(c.geom.pos);
+    r.normal = toVec3(c.geom.normal);
+    // An undriven contact imposes nothing (a non-finite law value never leaves here).
+    if (v.finite) r.surface_velocity = feeder_is_g1 ? c_g1 - c_g2 : c_g2 - c_g1;
+    records.push_back(r);
+  } catch (...) {
+    // Out of memory while recording: observation only, the contact stays driven.
+  }
+}
+
 FeederSet::FeederSet() : FeederSet(Options{}) {}
 
 FeederSet::FeederSet(const Options& options) : impl_(std::make_unique<Impl>()) {
@@ -250,6 +470,7 @@ FeederSet::FeederSet(const Options& options) : impl_(std::make_unique<Impl>()) {
         << " must be finite and >= 0 (m/s)";
     throw std::invalid_argument(out.str());
   }
+  requireFrictionModel(options.friction, "rheofeed::FeederSet: Options::friction");
   impl_->options = options;
 }
 
@@ -346,6 +567,9 @@ double FeederSet::time() const {
   return impl_->time;
 }
 
+// driveContacts, one contact at a time, in four named stages (Impl): lookup (which of the
+// contact's geoms are feeders), surface velocity (each feeder's law at the contact), write
+// (fdir1 / motion1 / mode into the dContact) and record (stats and ContactRecords).
 int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
   Impl& s = *impl_;
   if (count < 0 || (count > 0 && !contacts)) {
@@ -353,174 +577,28 @@ int FeederSet::driveContacts(dContact* contacts, int count) noexcept {
     return 0;
   }
   if (count == 0 || s.feeders.empty()) return count;
-  const Options& opt = s.options;
 
-  // Contacts of one dCollide call share their geoms: look the pair up once.
-  dGeomID last_g1 = nullptr, last_g2 = nullptr;
-  Impl::Feeder* f1 = nullptr;
-  Impl::Feeder* f2 = nullptr;
+  Impl::PairCache pair;  // contacts of one dCollide call share their geoms: one lookup
   int kept = 0;
   for (int i = 0; i < count; ++i) {
     dContact& c = contacts[i];
-    const dGeomID g1 = c.geom.g1, g2 = c.geom.g2;
-    if (g1 != last_g1 || g2 != last_g2) {
-      f1 = s.find(g1);
-      f2 = s.find(g2);
-      last_g1 = g1;
-      last_g2 = g2;
-    }
-    if (!f1 && !f2) {  // not a feeder contact: untouched
+    s.lookup(c, pair);
+    if (!pair.f1 && !pair.f2) {  // not a feeder contact: untouched
       if (kept != i) contacts[kept] = c;
       ++kept;
       continue;
     }
-    Impl::Feeder& primary = f1 ? *f1 : *f2;
-
+    Impl::Feeder& primary = pair.f1 ? *pair.f1 : *pair.f2;
     if (!Impl::contactValid(c)) {
       ++primary.stats.invalid_contacts;
       s.report(primary, DiagnosticKind::InvalidContact,
                [&] { return Impl::contactProblem(c) + "; contact removed"; });
       continue;
     }
-
-    // ODE's row order: node0 is the body attached first, unless it is 0 and the other is not.
-    dGeomID first = opt.attach_order == AttachOrder::G1First ? g1 : g2;
-    dGeomID second = first == g1 ? g2 : g1;
-    dBodyID b_first = bodyOf(first), b_second = bodyOf(second);
-    if (!b_first && b_second) {
-      std::swap(first, second);
-      std::swap(b_first, b_second);
-    }
-    Impl::Feeder* f_first = first == g1 ? f1 : f2;
-    Impl::Feeder* f_second = first == g1 ? f2 : f1;
-
-    const Vec3 p = toVec3(c.geom.pos);
-    const Vec3 n = toVec3(c.geom.normal);
-    Vec3 c_first, c_second;
-    bool finite = true;
-    for (Impl::Feeder* f : {f_first, f_second}) {
-      if (!f) continue;
-      Vec3 value;
-      // User functions (field, twist function, profile) run in here: whatever they throw is
-      // caught, and the contact is left undriven (no exception may unwind into ODE).
-      try {
-        const StepLaw& law = s.frozen(*f);
-        if (!law.finite()) {
-          finite = false;
-          ++(law.threw() ? f->stats.law_threw : f->stats.law_not_finite);
-          s.report(*f, law.threw() ? DiagnosticKind::LawThrew : DiagnosticKind::LawNotFinite,
-                   [&] { return law.problem() + "; contact left undriven"; });
-        } else {
-          if (law.needsContactSide()) {
-            // A local vibration law: the normal out of this feeder (ODE's points from g2 into
-            // g1), the contact's mu and the part's own efficiency.
-            const bool feeder_is_g1 = f == f1;
-            const dBodyID part = feeder_is_g1 ? bodyOf(g2) : bodyOf(g1);
-            Vec3 centre;  // the part's centre of mass (StepLaw::contactVelocity)
-            if (part) centre = toVec3(dBodyGetPosition(part));
-            value = law.contactVelocity(p, feeder_is_g1 ? -n : n, c.surface.mu,
-                                        s.partEfficiency(part), part ? &centre : nullptr);
-          } else {
-            value = law.tangentialVelocity(p, n);
-          }
-          // A secant law carries the body on the other side of the contact rigidly; it is then
-          // evaluated again. (Written this way because the if/else and ?: forms made every belt
-          // and translation contact ~15 ns slower with GCC 12 -O3, measured.)
-          if (law.usesCarriedPoint()) {
-            if (const dBodyID carried = f == f_first ? b_second : b_first) {
-              value = law.tangentialVelocity(p, n, toVec3(dBodyGetPosition(carried)));
-            }
-          }
-          // Non-finite, or beyond what ODE's motion1 can take (motion_law.hpp, Limits): a NaN
-          // component, or an inf (also from squares of finite components that overflow), fails
-          // the one comparison.
-          if (!(dot(value, value) <= kContactSpeedLimit2)) {
-            finite = false;
-            ++f->stats.law_not_finite;
-            s.report(*f, DiagnosticKind::LawNotFinite, [&] {
-              std::ostringstream out;
-              out << "law gave surface velocity (" << value.x << ", " << value.y << ", " << value.z
-                  << ") m/s at p = (" << p.x << ", " << p.y << ", " << p.z << "), t = " << s.time
-                  << ": not finite or beyond the limit |c_t| <= " << kMaxSurfaceSpeed
-                  << " m/s; contact left undriven";
-              return out.str();
-            });
-          }
-        }
-      } catch (...) {
-        finite = false;
-        value = Vec3{};
-        ++f->stats.law_threw;
-        s.report(*f, DiagnosticKind::LawThrew, [&] {
-          std::ostringstream out;
-          out << "law threw at p = (" << p.x << ", " << p.y << ", " << p.z << "), t = " << s.time
-              << ": " << detail::currentExceptionMessage() << "; contact left undriven";
-          return out.str();
-        });
-      }
-      (f == f_first ? c_first : c_second) = value;
-      if (f->changed) {  // the law changed: wake sleeping parts on it
-        Impl::wake(b_first, *f);
-        Impl::wake(b_second, *f);
-      }
-    }
-
-    dSurfaceParameters& surf = c.surface;
-    if (opt.force_approx1) {
-      surf.mode |= dContactApprox1;
-    } else if ((surf.mode & dContactApprox1) == 0 &&
-               !primary.reported[static_cast<int>(DiagnosticKind::ForceCapFriction)]) {
-      s.report(primary, DiagnosticKind::ForceCapFriction, [&] {
-        return "contact without dContactApprox1: mu = " + std::to_string(surf.mu) +
-               " is a force cap in newtons, not a coefficient";
-      });
-    }
-    if (surf.mu == 0) {
-      ++primary.stats.zero_friction;
-      s.report(primary, DiagnosticKind::ZeroFriction, [] {
-        return std::string(
-            "contact mu = 0: ODE applies no friction, so the surface motion has no effect");
-      });
-    }
-
-    const Vec3 c_rel = tangentialPart(c_second - c_first, n);
-    const double speed = finite ? norm(c_rel) : 0.0;
-    surf.mode &= ~(dContactMotion2);
-    surf.motion2 = 0;
-    if (!(speed > opt.min_surface_speed)) {
-      surf.mode &= ~(dContactFDir1 | dContactMotion1);
-      surf.motion1 = 0;
-      ++primary.stats.contacts_undriven;
-      if (f1 && f2) ++f2->stats.contacts_undriven;
-    } else {
-      const Vec3 t = (1.0 / speed) * c_rel;
-      c.fdir1[0] = t.x;
-      c.fdir1[1] = t.y;
-      c.fdir1[2] = t.z;
-      c.fdir1[3] = 0;
-      surf.motion1 = speed;
-      surf.mode |= dContactFDir1 | dContactMotion1;
-      ++primary.stats.contacts_driven;
-      if (f1 && f2) ++f2->stats.contacts_driven;
-    }
-
-    if (opt.record_contacts) {
-      try {
-        const bool feeder_is_g1 = f1 != nullptr;
-        const Vec3 c_g1 = first == g1 ? c_first : c_second;
-        const Vec3 c_g2 = first == g1 ? c_second : c_first;
-        ContactRecord r;
-        r.feeder = feeder_is_g1 ? g1 : g2;
-        r.part = feeder_is_g1 ? g2 : g1;
-        r.position = p;
-        r.normal = n;
-        // An undriven contact imposes nothing (a non-finite law value never leaves here).
-        if (finite) r.surface_velocity = feeder_is_g1 ? c_g1 - c_g2 : c_g2 - c_g1;
-        s.records.push_back(r);
-      } catch (...) {
-        // Out of memory while recording: observation only, the contact stays driven.
-      }
-    }
+    const Impl::Sides sides = s.sides(c, pair);
+    const Impl::Velocities velocities = s.surfaceVelocities(c, pair, sides);
+    const bool driven = s.write(c, primary, velocities);
+    s.record(c, pair, sides, velocities, driven);
     if (kept != i) contacts[kept] = c;
     ++kept;
   }
@@ -554,6 +632,15 @@ void FeederSet::setDiagnosticHandler(std::function<void(const Diagnostic&)> hand
 
 const FeederSet::Options& FeederSet::options() const {
   return impl_->options;
+}
+
+void FeederSet::setFrictionModel(FrictionModel model) {
+  requireFrictionModel(model, "rheofeed::FeederSet::setFrictionModel: friction");
+  impl_->options.friction = model;
+}
+
+FrictionModel FeederSet::frictionModel() const {
+  return impl_->options.friction;
 }
 
 }  // namespace rheofeed

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include "rheofeed/motion_law.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -534,6 +536,83 @@ bool StepLaw::sameMotionAs(const StepLaw& other) const {
     default:  // a secant also depends on the step length
       return v_ == other.v_ && w_ == other.w_ && o_ == other.o_ && step_ == other.step_;
   }
+}
+
+namespace {
+
+// Norm of the vector part of a quaternion when it is below the machine epsilon: the largest
+// component times the norm of the vector divided by it (no underflow of the squares).
+double smallVectorNorm(double x, double y, double z) {
+  const double largest = std::max(std::abs(x), std::max(std::abs(y), std::abs(z)));
+  if (!(largest > 0.0)) return largest == 0.0 ? 0.0 : largest;  // 0, or NaN kept
+  double inverse = 1.0 / largest, scale = largest;
+  if (inverse > std::numeric_limits<double>::max()) {
+    inverse = std::numeric_limits<double>::max();
+    scale = 1.0 / inverse;
+  }
+  const double a = x * inverse, b = y * inverse, c = z * inverse;
+  return scale * std::sqrt(a * a + b * b + c * c);
+}
+
+}  // namespace
+
+// The rotation R = R1 R0^T as a unit quaternion (Shoemake's method: from the trace when it is
+// positive, else from the largest diagonal entry), then as an axis and the angle
+// 2 atan2(|q_vec|, |q_w|) in [0, pi] with the axis's sign following q_w.
+Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h) {
+  const double* a = p1.rotation;
+  const double* b = p0.rotation;
+  // The sums are grouped as the reference world's earlier Eigen form grouped them (rows 0 and 1
+  // left to right, row 2 and the trace from the right), so that kinematic bodies keep their
+  // trajectories to the bit.
+  double m[3][3];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const double t0 = a[3 * i] * b[3 * j], t1 = a[3 * i + 1] * b[3 * j + 1],
+                   t2 = a[3 * i + 2] * b[3 * j + 2];
+      m[i][j] = i < 2 ? (t0 + t1) + t2 : t0 + (t1 + t2);
+    }
+  }
+  double q[3];  // vector part (x, y, z)
+  double w;
+  double t = m[0][0] + (m[1][1] + m[2][2]);
+  if (t > 0.0) {
+    t = std::sqrt(t + 1.0);
+    w = 0.5 * t;
+    t = 0.5 / t;
+    q[0] = (m[2][1] - m[1][2]) * t;
+    q[1] = (m[0][2] - m[2][0]) * t;
+    q[2] = (m[1][0] - m[0][1]) * t;
+  } else {
+    int i = 0;
+    if (m[1][1] > m[0][0]) i = 1;
+    if (m[2][2] > m[i][i]) i = 2;
+    const int j = (i + 1) % 3, k = (j + 1) % 3;
+    t = std::sqrt(m[i][i] - m[j][j] - m[k][k] + 1.0);
+    q[i] = 0.5 * t;
+    t = 0.5 / t;
+    w = (m[k][j] - m[j][k]) * t;
+    q[j] = (m[j][i] + m[i][j]) * t;
+    q[k] = (m[k][i] + m[i][k]) * t;
+  }
+  double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+  if (n < std::numeric_limits<double>::epsilon()) n = smallVectorNorm(q[0], q[1], q[2]);
+  double angle = 0.0;
+  Vec3 axis{1.0, 0.0, 0.0};
+  if (n != 0.0) {
+    angle = 2.0 * std::atan2(n, std::abs(w));
+    if (w < 0.0) n = -n;
+    axis = {q[0] / n, q[1] / n, q[2] / n};
+  }
+  const double rate = angle / h;
+  return {axis.x * rate, axis.y * rate, axis.z * rate};
+}
+
+Vec3 contactSurfaceVelocity(const StepLaw& law, const Vec3& p, const Vec3& n, const Vec3& n_out,
+                            double mu, double efficiency, const Vec3* carried) {
+  if (law.needsContactSide()) return law.contactVelocity(p, n_out, mu, efficiency, carried);
+  if (carried && law.usesCarriedPoint()) return law.tangentialVelocity(p, n, *carried);
+  return law.tangentialVelocity(p, n);
 }
 
 }  // namespace rheofeed

@@ -15,8 +15,6 @@
 namespace rheofeed {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // Grid steps of LocalDriftTable (header).
 constexpr double kThrowStep = 0.025;
 constexpr double kTangentialThrowStep = 0.05;

@@ -3,7 +3,8 @@
 # exit code 2, a message on stderr matching EXPECT (a regular expression), and no run or
 # calibration started. Used by the ctest cases in demos/CMakeLists.txt:
 #   cmake -DDEMO=<binary> -DARGS=<arguments separated by |> -DEXPECT=<regex>
-#         [-DFIFO=<path of a FIFO to create first>] -P cli_refusal_test.cmake
+#         [-DFIFO=<path of a FIFO to create first>] [-DABSENT=<path>] -P cli_refusal_test.cmake
+# ABSENT: removed first, and must not exist afterwards (an output folder not even created).
 # "|" separates the arguments so that an empty argument (--out "") survives: "--out|".
 if(FIFO)
   file(REMOVE "${FIFO}")
@@ -11,6 +12,9 @@ if(FIFO)
   if(NOT made EQUAL 0)
     message(FATAL_ERROR "could not create the FIFO ${FIFO}")
   endif()
+endif()
+if(ABSENT)
+  file(REMOVE_RECURSE "${ABSENT}")
 endif()
 # Each argument quoted on its own: an unquoted list expansion would drop an empty argument.
 string(REPLACE "|" ";" arguments "${ARGS}")
@@ -32,5 +36,8 @@ if(NOT err MATCHES "${EXPECT}")
 endif()
 if(err MATCHES "calibrating|runs at h =" OR out MATCHES "outputs in")
   message(FATAL_ERROR "a run started before the refusal:\nstdout:\n${out}\nstderr:\n${err}")
+endif()
+if(ABSENT AND EXISTS "${ABSENT}")
+  message(FATAL_ERROR "${ABSENT} was created before the refusal\nstdout:\n${out}\nstderr:\n${err}")
 endif()
 message(STATUS "refused as expected: ${err}")

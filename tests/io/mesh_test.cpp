@@ -16,7 +16,6 @@ namespace fs = std::filesystem;
 
 const fs::path kData = RHEOFEED_IO_TEST_DATA;
 const fs::path kDemoMeshes = fs::path(RHEOFEED_DEMO_DIR) / "meshes";
-constexpr double kPi = 3.14159265358979323846;
 
 // assimp stores coordinates as float: ~6e-9 m on the 0.2 m offsets of the test box, i.e. a few
 // 1e-7 of its 2 cm edges, so volume and inertia agree to a few 1e-6 relative.

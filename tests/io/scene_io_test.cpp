@@ -19,7 +19,6 @@ namespace {
 namespace fs = std::filesystem;
 
 const fs::path kData = RHEOFEED_IO_TEST_DATA;
-constexpr double kPi = 3.14159265358979323846;
 // Rotations go through axis-angle in the file: a few ulp per matrix entry.
 constexpr double kRotationTolerance = 1e-14;
 

@@ -231,43 +231,27 @@ static void localVibrationFromC(void) {
   dWorldDestroy(world);
 }
 
-int main(void) {
-  const double x_axis[3] = {1, 0, 0};
-  const double zero[3] = {0, 0, 0};
+/* The objects the checks of main share: a world, a static belt (top face at z = 0) with a
+ * box part on it, three spare geoms and the feeder set. */
+struct Fixture {
   dWorldID world;
   dJointGroupID joints;
   dGeomID belt, part_geom, other, field_geom, table_geom;
   dBodyID part;
-  dMass mass;
-  dContact contacts[8];
   rfFeederSetID set;
-  int n, driven, i, step, field_calls = 0;
-  struct Seen seen;
+};
+static const double x_axis[3] = {1, 0, 0};
+static const double zero[3] = {0, 0, 0};
 
-  dInitODE2(0);
-  dSetErrorHandler(odeMessage);
-  dSetDebugHandler(odeMessage);
-  dSetMessageHandler(odeMessage);
-  world = dWorldCreate();
-  dWorldSetGravity(world, 0, 0, -9.81);
-  joints = dJointGroupCreate(0);
-
-  belt = dCreateBox(0, 2.0, 1.0, 0.1); /* static, top face at z = 0 */
-  dGeomSetPosition(belt, 0, 0, -0.05);
-  part = dBodyCreate(world);
-  dMassSetBoxTotal(&mass, 1.0, 0.1, 0.1, 0.1);
-  dBodySetMass(part, &mass);
-  dBodySetPosition(part, 0, 0, 0.05 - 1e-3); /* 1 mm deep */
-  part_geom = dCreateBox(0, 0.1, 0.1, 0.1);
-  dGeomSetBody(part_geom, part);
-  other = dCreateBox(0, 1, 1, 1);
-  field_geom = dCreateBox(0, 1, 1, 1);
-  table_geom = dCreateBox(0, 1, 1, 1);
-
-  set = rfFeederSetCreate();
-  CHECK(set != 0);
-  if (!set) return 1;
-
+/* Register the belt, drive its contacts, step ODE until the part is carried at V. */
+static void driveAndCarry(struct Fixture* fx) {
+  dContact contacts[8];
+  int n, driven, i, step;
+  rfFeederSetID set = fx->set;
+  dWorldID world = fx->world;
+  dJointGroupID joints = fx->joints;
+  dGeomID belt = fx->belt, part_geom = fx->part_geom, other = fx->other;
+  dBodyID part = fx->part;
   /* Register and drive. */
   CHECK(rfFeederSetAddBelt(set, belt, x_axis, kSpeed, rfFrameWorld) == rfOK);
   CHECK(strcmp(rfFeederSetGetLastError(set), "") == 0);
@@ -321,7 +305,14 @@ int main(void) {
     dJointGroupEmpty(joints);
   }
   CHECK_NEAR(dBodyGetLinearVel(part)[0], kSpeed, 1e-6);
+}
 
+/* Ramp and on/off profiles on the belt. */
+static void profiles(struct Fixture* fx) {
+  dContact contacts[8];
+  int n, i;
+  rfFeederSetID set = fx->set;
+  dGeomID belt = fx->belt, part_geom = fx->part_geom;
   /* A ramp profile: halfway through, half the speed. */
   CHECK(rfFeederSetSetRamp(set, belt, 1.0, 2.0, 0.0, 1.0) == rfOK);
   CHECK(rfFeederSetBeginStep(set, 1.5) == rfOK);
@@ -341,7 +332,15 @@ int main(void) {
     CHECK((contacts[0].surface.mode & dContactMotion1) == 0);
     CHECK(contacts[0].surface.motion1 == 0.0);
   }
+}
 
+/* A C field function, and a turntable with and without the step. */
+static void fieldAndTurntable(struct Fixture* fx) {
+  dContact contacts[8];
+  int i, step, field_calls = 0;
+  rfFeederSetID set = fx->set;
+  dGeomID field_geom = fx->field_geom, part_geom = fx->part_geom, table_geom = fx->table_geom;
+  dBodyID part = fx->part;
   /* A C field function, called once per contact. */
   CHECK(rfFeederSetAddField(set, field_geom, yField, &field_calls, 0) == rfOK);
   CHECK(rfFeederSetBeginStep(set, 0.0) == rfOK);
@@ -396,7 +395,12 @@ int main(void) {
     CHECK(rfFeederSetBeginStepDt(0, 0.0, h) == rfErrorInvalidArgument);
     CHECK(rfFeederSetRemove(set, table_geom) == rfOK);
   }
+}
 
+/* Bad calls: error codes and messages naming the value. */
+static void errors(struct Fixture* fx) {
+  rfFeederSetID set = fx->set;
+  dGeomID belt = fx->belt, other = fx->other;
   /* Errors: a NaN speed, named in the message. */
   CHECK(rfFeederSetAddBelt(set, other, x_axis, NAN, rfFrameWorld) == rfErrorInvalidArgument);
   CHECK_MENTIONS(rfFeederSetGetLastError(set), "belt.speed");
@@ -431,7 +435,14 @@ int main(void) {
   /* A good call clears the message. */
   CHECK(rfFeederSetBeginStep(set, 0.0) == rfOK);
   CHECK(strcmp(rfFeederSetGetLastError(set), "") == 0);
+}
 
+/* Diagnostics, invalid calls, speed limits, removal, null handles and bad options. */
+static void diagnosticsAndBadCalls(struct Fixture* fx) {
+  dContact contacts[8];
+  struct Seen seen;
+  rfFeederSetID set = fx->set;
+  dGeomID belt = fx->belt, part_geom = fx->part_geom;
   /* Diagnostics: a negative mu on a feeder contact is removed and reported. */
   memset(&seen, 0, sizeof seen);
   rfFeederSetSetDiagnosticFunction(set, remember, &seen);
@@ -492,17 +503,69 @@ int main(void) {
     rfFeederSetDestroy(g2_first);
   }
   rfFeederSetDestroy(0);
+}
 
-  localVibrationFromC();
-
+/* The friction model from C: the cone where the linked ODE has it, else an error naming it. */
+static void frictionModelFromC(void) {
+  rfFeederSetID set = rfFeederSetCreate();
+  CHECK(set != 0);
+  if (!set) return;
+  CHECK(rfFeederSetSetFrictionModel(set, rfFrictionPyramid) == rfOK);
+  CHECK(rfFeederSetSetFrictionModel(set, 7) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "model = 7");
+  if (rfOdeHasFrictionCone()) {
+    CHECK(rfFeederSetSetFrictionModel(set, rfFrictionCone) == rfOK);
+  } else {
+    CHECK(rfFeederSetSetFrictionModel(set, rfFrictionCone) == rfErrorInvalidArgument);
+    CHECK_MENTIONS(rfFeederSetGetLastError(set), "friction");
+    CHECK_MENTIONS(rfFeederSetGetLastError(set), "ODE_EXT_friction_cone");
+  }
+  CHECK(rfFeederSetSetFrictionModel(0, rfFrictionPyramid) == rfErrorInvalidArgument);
   rfFeederSetDestroy(set);
-  dGeomDestroy(table_geom);
-  dGeomDestroy(field_geom);
-  dGeomDestroy(other);
-  dGeomDestroy(part_geom);
-  dGeomDestroy(belt);
-  dJointGroupDestroy(joints);
-  dWorldDestroy(world);
+}
+
+int main(void) {
+  struct Fixture fx;
+  dMass mass;
+
+  dInitODE2(0);
+  dSetErrorHandler(odeMessage);
+  dSetDebugHandler(odeMessage);
+  dSetMessageHandler(odeMessage);
+  fx.world = dWorldCreate();
+  dWorldSetGravity(fx.world, 0, 0, -9.81);
+  fx.joints = dJointGroupCreate(0);
+  fx.belt = dCreateBox(0, 2.0, 1.0, 0.1); /* static, top face at z = 0 */
+  dGeomSetPosition(fx.belt, 0, 0, -0.05);
+  fx.part = dBodyCreate(fx.world);
+  dMassSetBoxTotal(&mass, 1.0, 0.1, 0.1, 0.1);
+  dBodySetMass(fx.part, &mass);
+  dBodySetPosition(fx.part, 0, 0, 0.05 - 1e-3); /* 1 mm deep */
+  fx.part_geom = dCreateBox(0, 0.1, 0.1, 0.1);
+  dGeomSetBody(fx.part_geom, fx.part);
+  fx.other = dCreateBox(0, 1, 1, 1);
+  fx.field_geom = dCreateBox(0, 1, 1, 1);
+  fx.table_geom = dCreateBox(0, 1, 1, 1);
+  fx.set = rfFeederSetCreate();
+  CHECK(fx.set != 0);
+  if (!fx.set) return 1;
+
+  driveAndCarry(&fx);
+  profiles(&fx);
+  fieldAndTurntable(&fx);
+  errors(&fx);
+  diagnosticsAndBadCalls(&fx);
+  localVibrationFromC();
+  frictionModelFromC();
+
+  rfFeederSetDestroy(fx.set);
+  dGeomDestroy(fx.table_geom);
+  dGeomDestroy(fx.field_geom);
+  dGeomDestroy(fx.other);
+  dGeomDestroy(fx.part_geom);
+  dGeomDestroy(fx.belt);
+  dJointGroupDestroy(fx.joints);
+  dWorldDestroy(fx.world);
   dCloseODE();
 
   if (failures) {

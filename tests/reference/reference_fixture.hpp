@@ -17,7 +17,6 @@
 namespace rheofeed::reference::test {
 
 constexpr double kGravity = 9.81;  // m/s^2, |Settings::gravity| of every test world (along -z)
-constexpr double kPi = 3.14159265358979323846;
 
 /// Expects `needle` to be a substring of `haystack` (gtest shows both on failure).
 #define RHEOFEED_EXPECT_CONTAINS(haystack, needle) \

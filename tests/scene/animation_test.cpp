@@ -17,15 +17,15 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/output/animation.hpp"
 #include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/output/animation.hpp"
 #include "rheofeed/simulation/simulation.hpp"
+#include "scene_builders.hpp"
 
 namespace rheofeed::scene {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.14159265358979323846;
 
 // glTF stores 32-bit floats: a value x (m, s or a quaternion component) comes back within half
 // an ulp, |x| 2^-24 <= |x| FLT_EPSILON / 2; we allow FLT_EPSILON times max(1, |x|).
@@ -47,13 +47,9 @@ const Vec3 kDirection{std::cos(kPi / 6), 0, std::sin(kPi / 6)};
 Scene testScene() {
   Scene s;
   s.name = "animation test";
-  Fixture plate;
-  plate.name = "plate";
+  Fixture plate =
+      test::vibratingBox("plate", {0.3, 0.1, 0.01}, {0, 0, 0}, kAmplitude, kFrequency, kDirection);
   Fixture::Geom g;
-  g.shape.kind = Shape::Kind::Box;
-  g.shape.size = {0.3, 0.1, 0.01};
-  g.pose.position = {0, 0, -0.005};
-  plate.geoms.push_back(g);
   g.shape.kind = Shape::Kind::Cylinder;
   g.shape.radius = 0.005;
   g.shape.length = 0.3;
@@ -64,10 +60,6 @@ Scene testScene() {
   g.pose = Pose{};
   g.pose.position = {0.14, -0.055, 0.015};
   plate.geoms.push_back(g);
-  plate.law.kind = FeederLaw::Kind::Vibration;
-  plate.law.vibration.amplitude = kAmplitude;
-  plate.law.vibration.frequency = kFrequency;
-  plate.law.vibration.direction = kDirection;
   s.fixtures.push_back(plate);
   Fixture ground;
   ground.name = "ground";

@@ -20,6 +20,7 @@
 #include "rheofeed/scene/mesh.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 #include "rheofeed/simulation/simulation.hpp"
+#include "scene_builders.hpp"
 
 namespace rheofeed::scene {
 namespace {
@@ -28,15 +29,8 @@ constexpr double kG = 9.81;
 // The check's numbers are closed forms of the same inputs: only rounding differs.
 constexpr double kRelative = 1e-9;
 
-Fixture floorBox(double thickness) {
-  Fixture f;
-  f.name = "floor";
-  Fixture::Geom g;
-  g.shape.kind = Shape::Kind::Box;
-  g.shape.size = {1, 1, thickness};
-  g.pose.position = {0, 0, -0.5 * thickness};  // top at z = 0
-  f.geoms.push_back(g);
-  return f;
+Fixture floorBox(double thickness) {  // 1 m x 1 m, top at z = 0
+  return test::boxFixture("floor", {1, 1, thickness});
 }
 
 PartSpec cubes(double edge, double density, const Vec3& lo, const Vec3& hi, int count = 1) {

@@ -91,7 +91,7 @@ TEST(OdeVsReference, HelicalRampIsClimbedOnlyWhenOmegaMatchesItsHandedness) {
     const Comparison c = compare(s, Method::OdeRheonomic, Method::ReferenceRheonomic);
     // 1.5 s at w = 1 rad/s turns 1.5 rad; on a 0.1 m/turn helix that is 24 mm of height if
     // the part sticks; demand at least half of it in the right direction from both solvers.
-    const double expected_rise = 0.1 * 1.5 / (2 * M_PI);
+    const double expected_rise = 0.1 * 1.5 / (2 * kPi);
     for (const RunSummary* r : {&c.a, &c.b}) {
       SCOPED_TRACE(toString(r->method));
       const double rise = r->mean_position.z - z0;

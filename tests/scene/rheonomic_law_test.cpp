@@ -12,15 +12,15 @@
 #include <stdexcept>
 #include <string>
 
-#include "rheofeed/output/output.hpp"
 #include "rheofeed/measure/classical_model.hpp"
 #include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/output/output.hpp"
 #include "rheofeed/simulation/simulation.hpp"
+#include "scene_builders.hpp"
 
 namespace rheofeed::scene {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;        // m/s^2
 constexpr double kBeta = kPi / 6;  // vibration angle, 30 degrees
 constexpr double kMu = 0.5;
@@ -41,18 +41,8 @@ constexpr double kEfficiencyRatio = 0.02;  // relative
 Scene track(int count = 1) {
   Scene s;
   s.name = "local law track";
-  Fixture f;
-  f.name = "track";
-  Fixture::Geom g;
-  g.shape.kind = Shape::Kind::Box;
-  g.shape.size = {2, 0.4, 0.02};
-  g.pose.position = {0, 0, -0.01};
-  f.geoms.push_back(g);
-  f.law.kind = FeederLaw::Kind::Vibration;
-  f.law.vibration.amplitude = kAmplitude;
-  f.law.vibration.frequency = 50;
-  f.law.vibration.direction = {std::cos(kBeta), 0, std::sin(kBeta)};
-  s.fixtures.push_back(f);
+  s.fixtures.push_back(test::vibratingBox("track", {2, 0.4, 0.02}, {0, 0, 0}, kAmplitude, 50,
+                                          {std::cos(kBeta), 0, std::sin(kBeta)}));
   PartSpec p;
   p.name = "plates";
   p.size[0].mean = 0.03;

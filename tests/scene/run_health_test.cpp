@@ -16,9 +16,10 @@
 #include <vector>
 
 #include "common/builtin_scenes.hpp"
-#include "rheofeed/output/output.hpp"
 #include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/output/output.hpp"
 #include "rheofeed/simulation/simulation.hpp"
+#include "scene_builders.hpp"
 
 namespace rheofeed::scene {
 namespace {
@@ -28,14 +29,7 @@ const Method kRheonomic[] = {Method::OdeRheonomic, Method::ReferenceRheonomic};
 
 // A static box fixture whose top face is at z = top (m), centred on the origin in x and y.
 Fixture floorBox(double length, double width, double thickness, double top) {
-  Fixture f;
-  f.name = "floor";
-  Fixture::Geom g;
-  g.shape.kind = Shape::Kind::Box;
-  g.shape.size = {length, width, thickness};
-  g.pose.position = {0, 0, top - 0.5 * thickness};
-  f.geoms.push_back(g);
-  return f;
+  return test::boxFixture("floor", {length, width, thickness}, {0, 0, top});
 }
 
 // One cube of edge `edge` (m) at `at` (m) with initial velocity `v` (m/s).

@@ -23,7 +23,6 @@ namespace rheofeed::test {
 constexpr double kGravity = 9.81;   // m/s^2, along -z
 constexpr double kWorldErp = 0.2;   // dWorldSetERP of every test world
 constexpr double kWorldCfm = 1e-9;  // dWorldSetCFM of every test world (m/s per N of force)
-constexpr double kPi = 3.14159265358979323846;
 
 /// A body's state as plain numbers: position (m), quaternion (w, x, y, z), linear velocity
 /// (m/s), angular velocity (rad/s), all in the world frame.

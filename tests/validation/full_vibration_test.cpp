@@ -29,6 +29,7 @@
 
 #include "rheofeed/measure/classical_model.hpp"
 #include "rheofeed/simulation/simulation.hpp"
+#include "scene_builders.hpp"
 
 namespace rheofeed::scene {
 
@@ -39,7 +40,6 @@ void PrintTo(Method method, std::ostream* os) {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180;
 constexpr double kG = 9.81;
 
@@ -98,18 +98,9 @@ Scene trackScene(const TrackCase& c) {
   s.name = "vibrating_track_" + c.name;
   s.gravity = {-kG * std::sin(c.track_angle), 0, -kG * std::cos(c.track_angle)};
 
-  Fixture track;
-  track.name = "track";
-  Fixture::Geom g;
-  g.shape.kind = Shape::Kind::Box;
-  g.shape.size = {0.4, 0.1, 0.02};
-  g.pose.position = {0, 0, -0.01};  // top face at z = 0
-  track.geoms.push_back(g);
-  track.law.kind = FeederLaw::Kind::Vibration;
-  track.law.vibration.amplitude = p.amplitude;
-  track.law.vibration.frequency = c.frequency;
-  track.law.vibration.direction = {std::cos(beta), 0, std::sin(beta)};
-  s.fixtures.push_back(track);
+  s.fixtures.push_back(test::vibratingBox("track", {0.4, 0.1, 0.02}, {0, 0, 0},  // top at z = 0
+                                          p.amplitude, c.frequency,
+                                          {std::cos(beta), 0, std::sin(beta)}));
 
   PartSpec part;
   part.name = "flat_box";

@@ -22,7 +22,7 @@ constexpr double kRheonomicStep = 0.01;   // s: 2 vibration periods at 50 Hz
 
 Scene clusterScene() {
   // 50 Hz, 0.2 mm peak at 20 degrees: throw number 0.69, sliding regime.
-  Scene s = vibratingTrackScene(0.2e-3, 50, 20 * M_PI / 180, 8);
+  Scene s = vibratingTrackScene(0.2e-3, 50, 20 * kPi / 180, 8);
   s.name = "track_cluster";
   // A heap: parts dropped on each other in a small region, turned at random, so that the
   // upper ones ride on the lower ones (contacts the plugin does not drive) and push them.
@@ -70,7 +70,7 @@ TEST(RheonomicVsFullVibration, CalibratedDriftConveysACluster) {
 // The quick estimate (classical single-part model) and the sampling calibration (a short ODE
 // full-vibration run) are two independent routes to the same drift on a single flat part.
 TEST(Calibration, ClassicalEstimateMatchesSamplingOnASinglePart) {
-  const Scene scene = vibratingTrackScene(0.2e-3, 50, 20 * M_PI / 180, 1);
+  const Scene scene = vibratingTrackScene(0.2e-3, 50, 20 * kPi / 180, 1);
   const Calibration quick = calibrateClassical(scene, 0);
   CalibrationSettings cs;
   cs.steps_per_cycle = 400;  // 0.3 % time-discretisation error (tests/validation)

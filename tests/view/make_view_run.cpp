@@ -10,32 +10,21 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/output/output.hpp"
-#include "rheofeed/output/animation.hpp"
 #include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/output/animation.hpp"
+#include "rheofeed/output/output.hpp"
+#include "scene_builders.hpp"
 
 using namespace rheofeed;
 using namespace rheofeed::scene;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 Scene viewScene() {
   Scene s;
   s.name = "view_test";
-  Fixture plate;
-  plate.name = "plate";
-  Fixture::Geom g;
-  g.shape.kind = Shape::Kind::Box;
-  g.shape.size = {0.3, 0.1, 0.01};
-  g.pose.position = {0, 0, -0.005};
-  plate.geoms.push_back(g);
-  plate.law.kind = FeederLaw::Kind::Vibration;
-  plate.law.vibration.amplitude = 0.5e-3;
-  plate.law.vibration.frequency = 50;
-  plate.law.vibration.direction = {std::cos(kPi / 6), 0, std::sin(kPi / 6)};
-  s.fixtures.push_back(plate);
+  s.fixtures.push_back(test::vibratingBox("plate", {0.3, 0.1, 0.01}, {0, 0, 0}, 0.5e-3, 50,
+                                          {std::cos(kPi / 6), 0, std::sin(kPi / 6)}));
 
   PartSpec cubes;
   cubes.name = "cubes";

@@ -19,6 +19,12 @@
 /// `ContactCollider::nearCallback` to it (after `beginStep(time, h)` and `clearJoints()`), and
 /// call `rethrowPendingError()` after dSpaceCollide returns.
 ///
+/// ## Friction model
+/// Settings::friction sets dContactFrictionCone (cone) or clears it (pyramid) on every contact
+/// before the SurfaceCallback, which may choose per contact. A contact that asks for the cone
+/// when the linked ODE has none (a stock libode, which would silently solve the pyramid) is an
+/// error: std::invalid_argument naming the bit, rethrown by collide() (Exceptions below).
+///
 /// ## Exceptions
 /// No exception crosses ODE: the near callback catches everything thrown inside it (by the
 /// SurfaceCallback, by an allocation for the joint list), keeps the first exception, and does
@@ -58,13 +64,20 @@ class ContactCollider {
     /// joints(), and through FeederSet::records() for feeder contacts when the FeederSet has
     /// Options::record_contacts.
     bool feedback = false;
-    /// Surface used when no SurfaceCallback is set: Approx1 friction with mu = 0.5.
+    /// Surface every contact starts from (the SurfaceCallback may change it): Approx1 friction
+    /// with mu = 0.5.
     dSurfaceParameters default_surface = {
         dContactApprox1, 0.5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    /// Friction law of every contact (friction_model.hpp), set in default_surface's mode
+    /// before the SurfaceCallback runs (which may change it per contact, with
+    /// kContactFrictionCone); feeder contacts then get the FeederSet's friction model
+    /// (FeederSet::frictionModel). Cone needs the patched ODE and dWorldQuickStep.
+    FrictionModel friction = FrictionModel::Pyramid;
   };
 
   /// `world` receives the joints; `feeders` must outlive the collider. Throws
-  /// std::invalid_argument for a null world or max_contacts_per_pair outside 1..65535.
+  /// std::invalid_argument for a null world, max_contacts_per_pair outside 1..65535, or friction
+  /// = Cone on an ODE without the cone.
   ContactCollider(dWorldID world, FeederSet& feeders);
   ContactCollider(dWorldID world, FeederSet& feeders, const Settings& settings);
   ~ContactCollider();

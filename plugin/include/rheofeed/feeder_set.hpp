@@ -32,7 +32,9 @@
 ///   - `fdir1` = c_rel / |c_rel| (world frame, unit, orthogonal to the contact normal),
 ///   - `motion1` = |c_rel| (m/s, >= 0), `motion2` = 0,
 ///   - `mode |= dContactFDir1 | dContactMotion1` and, unless disabled, `dContactApprox1`
-///     (mu then is a friction coefficient, not a force in newtons).
+///     (mu then is a friction coefficient, not a force in newtons),
+///   - the friction model of Options::friction: dContactFrictionCone set (cone, patched ODE)
+///     or cleared (pyramid, ODE's own).
 /// The normal row (depth, ERP/CFM, bounce, motionN) is never touched.
 ///
 /// ## Attach order
@@ -62,6 +64,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "rheofeed/friction_model.hpp"
 #include "rheofeed/motion_law.hpp"
 
 namespace rheofeed {
@@ -139,9 +142,16 @@ class FeederSet {
     double min_surface_speed = 1e-9;
     /// Record every driven contact (ContactRecord) for slip / force observation.
     bool record_contacts = false;
+    /// Friction law of feeder contacts (friction_model.hpp): Pyramid clears, Cone sets
+    /// dContactFrictionCone on every feeder contact. Cone needs the patched ODE (the
+    /// constructor throws std::invalid_argument naming this setting on a stock library) and
+    /// dWorldQuickStep. Changed later with setFrictionModel.
+    FrictionModel friction = FrictionModel::Pyramid;
   };
 
   FeederSet();
+  /// Throws std::invalid_argument naming the option for a bad min_surface_speed, or for
+  /// friction = Cone when the linked ODE has no cone (odeHasFrictionCone()).
   explicit FeederSet(const Options& options);
   ~FeederSet();
   FeederSet(const FeederSet&) = delete;
@@ -212,6 +222,11 @@ class FeederSet {
   void setDiagnosticHandler(std::function<void(const Diagnostic&)> handler);
 
   const Options& options() const;
+  /// Change Options::friction (from the next driveContacts on). Throws std::invalid_argument
+  /// naming the setting for Cone when the linked ODE has no cone (nothing is changed then).
+  void setFrictionModel(FrictionModel model);
+  /// The friction model feeder contacts get (Options::friction or setFrictionModel).
+  FrictionModel frictionModel() const;
 
  private:
   struct Impl;

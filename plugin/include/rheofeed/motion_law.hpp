@@ -314,4 +314,27 @@ class StepLaw {
   std::string problem_;
 };
 
+/// Angular velocity (rad/s, world frame) that turns `p0`'s rotation into `p1`'s in `h` seconds
+/// (h > 0): the axis-angle of `R1 R0^T` divided by h, the secant of a prescribed rotation, as a
+/// kinematic body's velocity over a step (ODE's kinematic bodies and the reference world). The
+/// positions of the poses are not used. An angle is taken in [0, pi]; zero rotation gives zero.
+Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h);
+
+/// The surface velocity c_t (m/s, world) of the frozen `law` of one feeder at a contact: the one
+/// dispatch over the kinds of law that FeederSet and the reference world share.
+///   p        contact point (m, world)
+///   n        unit contact normal handed to laws that need no side (tangentialVelocity: the
+///            tangential projection, and a SurfaceField receives it as given)
+///   n_out    unit normal pointing out of this feeder into the other geom (a local vibration
+///            law's side: StepLaw::contactVelocity)
+///   mu       the contact's friction coefficient (local vibration laws)
+///   efficiency  the other body's own efficiency factor (local vibration laws; 1 = the law's)
+///   carried  centre of mass (m, world) of the body on the other side of the contact, null for
+///            a static geom: a secant law carries it rigidly, a local law is evaluated at its
+///            projection on the contact plane (StepLaw::contactVelocity).
+/// Propagates what a user function (field, twist function) throws; the caller checks the value
+/// against the limits (StepLaw::tangentialVelocity).
+Vec3 contactSurfaceVelocity(const StepLaw& law, const Vec3& p, const Vec3& n, const Vec3& n_out,
+                            double mu, double efficiency, const Vec3* carried);
+
 }  // namespace rheofeed

@@ -161,6 +161,18 @@ int rfFeederSetDriveContacts(rfFeederSetID set, dContact* contacts, int count);
  *  rfError code for an unregistered geom. */
 int rfFeederSetGetContactsDriven(rfFeederSetID set, dGeomID geom);
 
+/** Friction models (rfFeederSetSetFrictionModel). */
+enum { rfFrictionPyramid = 0, rfFrictionCone = 1 };
+/** The friction law of this set's feeder contacts: rfFrictionPyramid (stock ODE's per-axis
+ *  limit mu N, the default) or rfFrictionCone (the two friction impulses limited together to
+ *  mu N: rheofeed's patched ODE only, and dWorldQuickStep only). rfErrorInvalidArgument (the
+ *  message names the setting and the library's configuration) for an unknown model or for
+ *  rfFrictionCone when the linked ODE has no cone; nothing is changed then. */
+int rfFeederSetSetFrictionModel(rfFeederSetID set, int model);
+/** 1 if the linked ODE has rheofeed's friction cone (dCheckConfiguration(
+ *  "ODE_EXT_friction_cone")), else 0. */
+int rfOdeHasFrictionCone(void);
+
 /** Receive diagnostics (0 restores the default: first report per kind and feeder on stderr). */
 void rfFeederSetSetDiagnosticFunction(rfFeederSetID set, rfDiagnosticFunction* fn, void* user);
 

@@ -8,6 +8,9 @@
 
 namespace rheofeed {
 
+/// pi, defined once for the whole project (C++17 has no std::numbers::pi).
+inline constexpr double kPi = 3.14159265358979323846;
+
 /// A 3-vector of doubles. Its unit and frame are those of the value it carries; every function
 /// that takes or returns one says which.
 struct Vec3 {

@@ -53,12 +53,58 @@ constexpr double kBacktrackSlack = 16.0 * std::numeric_limits<double>::epsilon()
 // Per-iteration decrease of the Lipschitz estimate (paper: 0.9).
 constexpr double kLipschitzDecrease = 0.9;
 
+// Lipschitz estimate of N from the ones vector (ws.y, ws.n_y used as scratch); the largest
+// mean block eigenvalue when that product is zero or not finite.
+double initialLipschitz(const Problem& problem, Workspace& ws) {
+  Eigen::VectorXd& y = ws.y;
+  Eigen::VectorXd& n_y = ws.n_y;
+  y.setOnes();
+  multiplyDelassus(problem, y, n_y, ws);
+  double lipschitz = safeNorm(n_y) / std::sqrt(double(y.size()));
+  if (!(lipschitz > 0.0) || !std::isfinite(lipschitz)) {
+    lipschitz = 0.0;
+    for (Eigen::Index i = 0; i < problem.numContacts(); ++i) {
+      lipschitz = std::max(lipschitz, problem.diagonalBlock(i).trace() / 3.0);
+    }
+  }
+  return lipschitz;
+}
+
+// Projected gradient step from ws.y into ws.next (ws.n_next = N next) with backtracking on L
+// (doubled until the quadratic model holds). False when the backtracking did not terminate.
+bool projectedStep(const Problem& problem, const Eigen::VectorXd& r, const Eigen::VectorXd& mu,
+                   Workspace& ws, double& lipschitz) {
+  const Eigen::VectorXd& y = ws.y;
+  const Eigen::VectorXd& n_y = ws.n_y;
+  Eigen::VectorXd& next = ws.next;
+  Eigen::VectorXd& n_next = ws.n_next;
+  for (int backtrack = 0; backtrack <= kMaxBacktracks; ++backtrack) {
+    const double step = 1.0 / lipschitz;
+    for (Eigen::Index i = 0; i < problem.numContacts(); ++i) {
+      const Eigen::Vector3d trial =
+          y.segment<3>(3 * i) - step * (n_y.segment<3>(3 * i) + r.segment<3>(3 * i));
+      next.segment<3>(3 * i) = projectOntoCone(trial, mu[i]);
+    }
+    multiplyDelassus(problem, next, n_next, ws);
+    // d^T N d <= L ||d||^2 with d = next - y, N d = n_next - n_y, both sides divided by
+    // max|d_i|^2 so that neither overflows nor underflows on data far from 1.
+    const double d_max = (next - y).cwiseAbs().maxCoeff();
+    if (d_max == 0.0) return true;  // y is a fixed point of the projected step
+    const double curvature = ((next - y) / d_max).dot((n_next - n_y) / d_max);
+    const double squared_step = ((next - y) / d_max).squaredNorm();
+    const double slack =
+        kBacktrackSlack * std::sqrt(squared_step) * (safeNorm(n_next) + safeNorm(n_y)) / d_max;
+    if (curvature <= lipschitz * squared_step + slack) return true;
+    lipschitz *= 2.0;
+  }
+  return false;
+}
+
 }  // namespace
 
 InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Eigen::VectorXd& mu,
                      const Settings& settings, const Deadline& deadline, Eigen::VectorXd& gamma,
                      Workspace& ws) {
-  const Eigen::Index nc = problem.numContacts();
   const double rho = settings.residual_rho;
   InnerOutcome out;
 
@@ -69,16 +115,7 @@ InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Eig
   Eigen::VectorXd& y = ws.y;
   Eigen::VectorXd& n_y = ws.n_y;
 
-  // Lipschitz estimate from the ones vector (y, n_y used as scratch).
-  y.setOnes();
-  multiplyDelassus(problem, y, n_y, ws);
-  double lipschitz = safeNorm(n_y) / std::sqrt(double(y.size()));
-  if (!(lipschitz > 0.0) || !std::isfinite(lipschitz)) {
-    lipschitz = 0.0;
-    for (Eigen::Index i = 0; i < nc; ++i) {
-      lipschitz = std::max(lipschitz, problem.diagonalBlock(i).trace() / 3.0);
-    }
-  }
+  double lipschitz = initialLipschitz(problem, ws);
 
   gk = gamma;
   multiplyDelassus(problem, gk, n_gk, ws);
@@ -103,33 +140,7 @@ InnerOutcome runApgd(const Problem& problem, const Eigen::VectorXd& r, const Eig
   out.status = Status::MaxIterations;
   for (int k = 1; k <= settings.max_iterations; ++k) {
     out.iterations = k;
-    // Projected gradient step from y with backtracking on L.
-    bool accepted = false;
-    for (int backtrack = 0; backtrack <= kMaxBacktracks; ++backtrack) {
-      const double step = 1.0 / lipschitz;
-      for (Eigen::Index i = 0; i < nc; ++i) {
-        const Eigen::Vector3d trial =
-            y.segment<3>(3 * i) - step * (n_y.segment<3>(3 * i) + r.segment<3>(3 * i));
-        next.segment<3>(3 * i) = projectOntoCone(trial, mu[i]);
-      }
-      multiplyDelassus(problem, next, n_next, ws);
-      // d^T N d <= L ||d||^2 with d = next - y, N d = n_next - n_y, both sides divided by
-      // max|d_i|^2 so that neither overflows nor underflows on data far from 1.
-      const double d_max = (next - y).cwiseAbs().maxCoeff();
-      if (d_max == 0.0) {
-        accepted = true;  // y is a fixed point of the projected step
-        break;
-      }
-      const double curvature = ((next - y) / d_max).dot((n_next - n_y) / d_max);
-      const double squared_step = ((next - y) / d_max).squaredNorm();
-      const double slack =
-          kBacktrackSlack * std::sqrt(squared_step) * (safeNorm(n_next) + safeNorm(n_y)) / d_max;
-      if (curvature <= lipschitz * squared_step + slack) {
-        accepted = true;
-        break;
-      }
-      lipschitz *= 2.0;
-    }
+    const bool accepted = projectedStep(problem, r, mu, ws, lipschitz);
     if (!accepted || !std::isfinite(lipschitz)) {
       out.status = Status::NumericalIssue;
       out.issue = "APGD: Lipschitz backtracking did not terminate";

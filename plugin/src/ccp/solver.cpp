@@ -125,20 +125,10 @@ void projectOntoCones(Eigen::VectorXd& gamma, const Eigen::VectorXd& mu) {
   }
 }
 
-}  // namespace detail
-
-namespace {
-
-std::string format(const char* fmt, double a, double b = 0.0) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof buffer, fmt, a, b);
-  return std::string(buffer);
-}
-
 // Fills the measures of `result` for impulses gamma with u = N gamma + r (u given).
 void computeMeasures(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
-                     const Eigen::VectorXd& r, const Eigen::VectorXd& mu, double rho,
-                     detail::Workspace& ws, Result& result) {
+                     const Eigen::VectorXd& r, const Eigen::VectorXd& mu, double rho, Workspace& ws,
+                     Result& result) {
   double dual = 0.0;
   double complementarity = 0.0;
   for (Eigen::Index i = 0; i < mu.size(); ++i) {
@@ -151,7 +141,17 @@ void computeMeasures(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
   result.complementarity = complementarity;
   // 1/2 g^T N g + r^T g with N g = u - r.
   result.objective = 0.5 * gamma.dot(u + r);
-  result.coulomb_distance = detail::relativeResidual(gamma, u, r, mu, rho, true, ws);
+  result.coulomb_distance = relativeResidual(gamma, u, r, mu, rho, true, ws);
+}
+
+}  // namespace detail
+
+namespace {
+
+std::string format(const char* fmt, double a, double b = 0.0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, fmt, a, b);
+  return std::string(buffer);
 }
 
 }  // namespace
@@ -216,230 +216,287 @@ Solver::~Solver() = default;
 Solver::Solver(Solver&&) noexcept = default;
 Solver& Solver::operator=(Solver&&) noexcept = default;
 
+namespace {
+
+// One solve's state, shared by its stages (Solver::solve below): the problem, settings and
+// workspace, the impulses being solved for, the result being filled and the inner outcome.
+struct SolveContext {
+  const Problem& problem;
+  const Settings& settings;
+  const detail::Deadline& deadline;
+  Eigen::VectorXd& gamma;
+  detail::Workspace& ws;
+  Result& result;
+  detail::InnerOutcome outcome;
+
+  // One relaxed solve with the free velocity `r` and friction coefficients `mu`.
+  detail::InnerOutcome inner(const Eigen::VectorXd& r, const Eigen::VectorXd& mu) {
+    return settings.method == Method::Pgs
+               ? detail::runPgs(problem, r, mu, settings, deadline, gamma, ws)
+               : detail::runApgd(problem, r, mu, settings, deadline, gamma, ws);
+  }
+  // ws.u = N gamma + r_problem; used for the shift and the final measures.
+  void physicalVelocity() {
+    detail::multiplyDelassus(problem, gamma, ws.u, ws);
+    ws.u += problem.r;
+  }
+  // s_i = mu_i ||u_t,i|| from ws.u.
+  void updateShift(Eigen::VectorXd& shift) const {
+    for (Eigen::Index i = 0; i < problem.numContacts(); ++i)
+      shift[i] = problem.mu[i] * std::hypot(ws.u[3 * i + 1], ws.u[3 * i + 2]);
+  }
+  // A non-finite Coulomb residual or shift (overflow of mu ||u_t|| or of N gamma) ends the
+  // loop as a numerical issue, never as an iteration limit.
+  void numericalIssue(const char* issue) {
+    outcome.status = Status::NumericalIssue;
+    outcome.issue = issue;
+  }
+  double coulombResidual() {
+    return detail::relativeResidual(gamma, ws.u, problem.r, problem.mu, settings.residual_rho, true,
+                                    ws);
+  }
+};
+
+// Stage 1: settings and problem checks. Empty when usable, else the InvalidInput message.
+std::string inputProblem(const Settings& settings, const Problem& problem) {
+  if (std::string message = settings.validate(); !message.empty()) {
+    return "invalid settings: " + message;
+  }
+  if (std::string message = problem.validate(); !message.empty()) {
+    return "invalid problem: " + message;
+  }
+  return {};
+}
+
+// Stage 2: workspace sizes, contact scales and the initial guess (warm start or zero).
+void prepare(SolveContext& c) {
+  const Eigen::Index n = c.problem.size();
+  c.ws.resize(c.problem.numContacts(), c.problem.numDofs());
+  detail::computeContactScales(c.problem, c.ws);
+  const bool warm = c.settings.warm_start && c.gamma.size() == n && c.gamma.allFinite();
+  if (warm) {
+    detail::projectOntoCones(c.gamma, c.problem.mu);
+  } else {
+    c.gamma.resize(n);
+    c.gamma.setZero();
+  }
+}
+
+// What the outer fixed point of the Coulomb mode ends with.
+struct FixedPointEnd {
+  bool reached = false;  // a Coulomb solution to the tolerance, or a settled shift
+  double best_coulomb = std::numeric_limits<double>::infinity();
+  double best_inner_residual = std::numeric_limits<double>::quiet_NaN();
+};
+
+// Stage 3b: the true-Coulomb outer fixed point on De Saxce's shift (file comment).
+//
+// Outer iteration 0 is the relaxed CCP itself (shift 0), from the incoming gamma: where no
+// contact slides it already is the Coulomb solution (issue 9: a cold fixed point took 45000
+// APGD iterations on a problem whose relaxed solution, 505 iterations, satisfied Coulomb).
+// Otherwise the shift iteration starts from the incoming gamma and its shift, as a fixed
+// point from the relaxed solution can stall (measured on the rank-deficient Capsules fc3d
+// problem: Coulomb residual 2e-8 after 200 outer iterations from the relaxed solution,
+// converged from gamma = 0). Every iterate, the relaxed one included, is judged by its own
+// Coulomb residual for the problem's r, and the best one is returned when the fixed point
+// does not settle.
+FixedPointEnd coulombFixedPoint(SolveContext& c) {
+  const Problem& problem = c.problem;
+  const Settings& settings = c.settings;
+  detail::Workspace& ws = c.ws;
+  const Eigen::Index nc = problem.numContacts();
+  FixedPointEnd end;
+  ws.coulomb_start = c.gamma;
+  ws.shift.setZero();
+  double change = 0.0;
+  for (int outer = 0; outer < settings.coulomb_outer_iterations; ++outer) {
+    ws.r_shifted = problem.r;
+    for (Eigen::Index i = 0; i < nc; ++i) ws.r_shifted[3 * i] += ws.shift[i];
+    c.outcome = c.inner(ws.r_shifted, problem.mu);
+    c.result.iterations += c.outcome.iterations;
+    c.result.outer_iterations = outer + 1;
+    if (c.outcome.status == Status::NumericalIssue || c.outcome.timed_out) break;
+    c.physicalVelocity();
+    const double coulomb = c.coulombResidual();
+    if (!std::isfinite(coulomb)) {
+      c.numericalIssue(
+          "Coulomb mode: non-finite Coulomb residual (impulses or velocities "
+          "overflowed)");
+      break;
+    }
+    // The relaxed iterate is returned only as a Coulomb solution (below): as a best-effort
+    // answer it would separate every sliding contact at mu ||u_t||, which is what Coulomb
+    // mode exists to avoid. (With coulomb_outer_iterations == 1 it is the only iterate.)
+    const bool candidate = outer > 0 || settings.coulomb_outer_iterations == 1;
+    if (candidate && coulomb < end.best_coulomb) {
+      end.best_coulomb = coulomb;
+      end.best_inner_residual = c.outcome.residual;
+      ws.coulomb_best = c.gamma;
+    }
+    if (coulomb <= settings.tolerance) {
+      end.reached = true;  // a Coulomb solution to the tolerance, however reached
+      break;
+    }
+    if (outer == 0) {
+      c.gamma = ws.coulomb_start;
+      c.physicalVelocity();
+      c.updateShift(ws.shift);
+      if (!ws.shift.allFinite()) {
+        c.numericalIssue("Coulomb mode: non-finite normal shift mu ||u_t|| (overflow)");
+        break;
+      }
+      continue;
+    }
+    c.updateShift(ws.shift_new);
+    if (!ws.shift_new.allFinite()) {
+      c.numericalIssue("Coulomb mode: non-finite normal shift mu ||u_t|| (overflow)");
+      break;
+    }
+    // Dimensionless like the residual: the shift (m/s) relative to the velocity scale
+    // max(||r||, ||N gamma||) of the current iterate.
+    const double velocity_scale =
+        std::max(detail::safeNorm(problem.r), detail::safeNorm(ws.u - problem.r));
+    const double shift_change = detail::safeNorm(ws.shift_new - ws.shift);
+    change = shift_change == 0.0 ? 0.0 : shift_change / velocity_scale;
+    ws.shift.swap(ws.shift_new);
+    if (change <= settings.coulomb_tolerance && c.outcome.status == Status::Converged) {
+      end.reached = true;
+      break;
+    }
+  }
+  return end;
+}
+
+// Stage 3c: frozen-friction normal correction of the best iterate (file comment). Returns true
+// when the rounds settled and the corrected impulses meet the Coulomb tolerance.
+bool frozenFrictionCorrection(SolveContext& c) {
+  const Problem& problem = c.problem;
+  detail::Workspace& ws = c.ws;
+  Eigen::VectorXd& gamma = c.gamma;
+  const Eigen::Index nc = problem.numContacts();
+  ws.zero_mu.setZero();
+  const int shrink_rounds = 10 * c.settings.coulomb_outer_iterations;
+  bool settled = false;
+  for (int round = 0; !settled; ++round) {
+    const bool drop = round >= shrink_rounds;  // past the budget: drop, not shrink
+    ws.friction = gamma;
+    for (Eigen::Index i = 0; i < nc; ++i) {
+      ws.friction[3 * i] = 0.0;
+      gamma.segment<2>(3 * i + 1).setZero();
+    }
+    detail::multiplyDelassus(problem, ws.friction, ws.r_normal, ws);
+    ws.r_normal += problem.r;
+    const detail::InnerOutcome normal = c.inner(ws.r_normal, ws.zero_mu);
+    c.result.iterations += normal.iterations;
+    c.result.normal_correction_rounds = round + 1;
+    if (normal.status == Status::NumericalIssue || normal.timed_out) {
+      c.outcome.status = normal.status;
+      c.outcome.timed_out = normal.timed_out;
+      c.outcome.issue = normal.issue;
+      gamma = ws.coulomb_best;  // the best iterate, uncorrected
+      break;
+    }
+    settled = true;
+    for (Eigen::Index i = 0; i < nc; ++i) {
+      Eigen::Ref<Eigen::Vector2d> t = ws.friction.segment<2>(3 * i + 1);
+      const double limit = problem.mu[i] * gamma[3 * i];
+      const double magnitude = t.norm();
+      if (magnitude > limit) {
+        settled = false;
+        if (drop || !(magnitude > 0.0)) {
+          t.setZero();
+          ++c.result.friction_dropped_contacts;
+        } else {
+          t *= limit / magnitude;
+        }
+      }
+      gamma.segment<2>(3 * i + 1) = t;
+    }
+    c.outcome.residual = normal.residual;
+  }
+  c.result.normal_correction_settled = settled;
+  if (!settled) return false;
+  // The corrected impulses may satisfy the Coulomb law to the tolerance themselves.
+  c.physicalVelocity();
+  return c.coulombResidual() <= c.settings.tolerance;
+}
+
+// Stage 3 (Coulomb mode): the fixed point, then, when it does not settle, the best iterate with
+// its normals corrected where it separates a pressed contact; sets the outcome's status.
+void solveCoulomb(SolveContext& c) {
+  FixedPointEnd end = coulombFixedPoint(c);
+  const bool have_best = end.best_coulomb < std::numeric_limits<double>::infinity();
+  if (!end.reached && have_best) {
+    c.gamma = c.ws.coulomb_best;
+    c.outcome.residual = end.best_inner_residual;
+    // The largest normal velocity of a contact that carries a normal impulse: a separation
+    // the impulses themselves produce (for a converged solve it is zero up to the tolerance).
+    c.physicalVelocity();
+    double separation = 0.0;
+    for (Eigen::Index i = 0; i < c.problem.numContacts(); ++i) {
+      if (c.gamma[3 * i] > 0.0) separation = std::max(separation, c.ws.u[3 * i]);
+    }
+    c.result.best_iterate_separation = separation;
+    if (separation > c.settings.coulomb_max_separation &&
+        c.outcome.status != Status::NumericalIssue && !c.outcome.timed_out) {
+      if (frozenFrictionCorrection(c)) end.reached = true;
+    }
+  }
+  if (end.reached) c.outcome.status = Status::Converged;
+  if (c.outcome.status != Status::NumericalIssue && !c.outcome.timed_out && !end.reached) {
+    c.outcome.status = Status::MaxIterations;
+    c.result.message = format(
+        "Coulomb fixed point not reached after %g outer iterations: returned the best iterate, "
+        "Coulomb residual %g",
+        c.result.outer_iterations, end.best_coulomb);
+  }
+}
+
+// Stage 4: status, message and the quality measures of the returned gamma.
+void finish(SolveContext& c) {
+  Result& result = c.result;
+  result.status = c.outcome.status;
+  if (c.outcome.status == Status::NumericalIssue && c.outcome.issue != nullptr) {
+    result.message = c.outcome.issue;
+  } else if (c.outcome.timed_out) {
+    result.message = format("time limit of %g s reached", c.deadline.limit());
+  }
+  c.physicalVelocity();
+  detail::computeMeasures(c.gamma, c.ws.u, c.problem.r, c.problem.mu, c.settings.residual_rho, c.ws,
+                          result);
+  if (c.settings.coulomb_outer_iterations == 0) {
+    result.residual = detail::relativeResidual(c.gamma, c.ws.u, c.problem.r, c.problem.mu,
+                                               c.settings.residual_rho, false, c.ws);
+  } else {
+    result.residual = c.outcome.residual;
+  }
+}
+
+}  // namespace
+
 Result Solver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
   const detail::Deadline deadline(settings_.time_limit_s);
   Result result;
-  auto finish = [&]() -> Result {
+  if (std::string message = inputProblem(settings_, problem); !message.empty()) {
+    result.status = Status::InvalidInput;
+    result.message = std::move(message);
     result.solve_time_s = deadline.elapsed();
-    return std::move(result);
-  };
-
-  if (std::string message = settings_.validate(); !message.empty()) {
-    result.status = Status::InvalidInput;
-    result.message = "invalid settings: " + message;
-    return finish();
+    return result;
   }
-  if (std::string message = problem.validate(); !message.empty()) {
-    result.status = Status::InvalidInput;
-    result.message = "invalid problem: " + message;
-    return finish();
-  }
-
-  const Eigen::Index nc = problem.numContacts();
-  const Eigen::Index n = problem.size();
   if (!workspace_) workspace_ = std::make_unique<Workspace>();
-  detail::Workspace& ws = *workspace_;
-  ws.resize(nc, problem.numDofs());
-  detail::computeContactScales(problem, ws);
-
-  const bool warm = settings_.warm_start && gamma.size() == n && gamma.allFinite();
-  if (warm) {
-    detail::projectOntoCones(gamma, problem.mu);
-  } else {
-    gamma.resize(n);
-    gamma.setZero();
-  }
-
-  auto inner = [&](const Eigen::VectorXd& r, const Eigen::VectorXd& mu) {
-    return settings_.method == Method::Pgs
-               ? detail::runPgs(problem, r, mu, settings_, deadline, gamma, ws)
-               : detail::runApgd(problem, r, mu, settings_, deadline, gamma, ws);
-  };
-  // ws.u = N gamma + r_problem; used for the shift and the final measures.
-  auto physicalVelocity = [&]() {
-    detail::multiplyDelassus(problem, gamma, ws.u, ws);
-    ws.u += problem.r;
-  };
-  auto updateShift = [&](Eigen::VectorXd& shift) {
-    for (Eigen::Index i = 0; i < nc; ++i)
-      shift[i] = problem.mu[i] * std::hypot(ws.u[3 * i + 1], ws.u[3 * i + 2]);
-  };
-
-  detail::InnerOutcome outcome;
-  if (n == 0) {
-    outcome.status = Status::Converged;
+  SolveContext context{problem, settings_, deadline, gamma, *workspace_, result, {}};
+  prepare(context);
+  if (problem.size() == 0) {
+    context.outcome.status = Status::Converged;
   } else if (settings_.coulomb_outer_iterations == 0) {
-    outcome = inner(problem.r, problem.mu);
-    result.iterations = outcome.iterations;
+    context.outcome = context.inner(problem.r, problem.mu);
+    result.iterations = context.outcome.iterations;
   } else {
-    // Outer iteration 0 is the relaxed CCP itself (shift 0), from the incoming gamma: where no
-    // contact slides it already is the Coulomb solution (issue 9: a cold fixed point took 45000
-    // APGD iterations on a problem whose relaxed solution, 505 iterations, satisfied Coulomb).
-    // Otherwise the shift iteration starts from the incoming gamma and its shift, as a fixed
-    // point from the relaxed solution can stall (measured on the rank-deficient Capsules fc3d
-    // problem: Coulomb residual 2e-8 after 200 outer iterations from the relaxed solution,
-    // converged from gamma = 0). Every iterate, the relaxed one included, is judged by its own
-    // Coulomb residual for the problem's r, and the best one is returned when the fixed point
-    // does not settle.
-    const double rho = settings_.residual_rho;
-    // A non-finite Coulomb residual or shift (overflow of mu ||u_t|| or of N gamma) ends the
-    // loop as a numerical issue, never as an iteration limit.
-    auto numericalIssue = [&](const char* issue) {
-      outcome.status = Status::NumericalIssue;
-      outcome.issue = issue;
-    };
-    ws.coulomb_start = gamma;
-    ws.shift.setZero();
-    bool fixed_point_reached = false;
-    double change = 0.0;
-    double best_coulomb = std::numeric_limits<double>::infinity();
-    double best_inner_residual = std::numeric_limits<double>::quiet_NaN();
-    for (int outer = 0; outer < settings_.coulomb_outer_iterations; ++outer) {
-      ws.r_shifted = problem.r;
-      for (Eigen::Index i = 0; i < nc; ++i) ws.r_shifted[3 * i] += ws.shift[i];
-      outcome = inner(ws.r_shifted, problem.mu);
-      result.iterations += outcome.iterations;
-      result.outer_iterations = outer + 1;
-      if (outcome.status == Status::NumericalIssue || outcome.timed_out) break;
-      physicalVelocity();
-      const double coulomb =
-          detail::relativeResidual(gamma, ws.u, problem.r, problem.mu, rho, true, ws);
-      if (!std::isfinite(coulomb)) {
-        numericalIssue(
-            "Coulomb mode: non-finite Coulomb residual (impulses or velocities "
-            "overflowed)");
-        break;
-      }
-      // The relaxed iterate is returned only as a Coulomb solution (below): as a best-effort
-      // answer it would separate every sliding contact at mu ||u_t||, which is what Coulomb
-      // mode exists to avoid. (With coulomb_outer_iterations == 1 it is the only iterate.)
-      const bool candidate = outer > 0 || settings_.coulomb_outer_iterations == 1;
-      if (candidate && coulomb < best_coulomb) {
-        best_coulomb = coulomb;
-        best_inner_residual = outcome.residual;
-        ws.coulomb_best = gamma;
-      }
-      if (coulomb <= settings_.tolerance) {
-        fixed_point_reached = true;  // a Coulomb solution to the tolerance, however reached
-        break;
-      }
-      if (outer == 0) {
-        gamma = ws.coulomb_start;
-        physicalVelocity();
-        updateShift(ws.shift);
-        if (!ws.shift.allFinite()) {
-          numericalIssue("Coulomb mode: non-finite normal shift mu ||u_t|| (overflow)");
-          break;
-        }
-        continue;
-      }
-      updateShift(ws.shift_new);
-      if (!ws.shift_new.allFinite()) {
-        numericalIssue("Coulomb mode: non-finite normal shift mu ||u_t|| (overflow)");
-        break;
-      }
-      // Dimensionless like the residual: the shift (m/s) relative to the velocity scale
-      // max(||r||, ||N gamma||) of the current iterate.
-      const double velocity_scale =
-          std::max(detail::safeNorm(problem.r), detail::safeNorm(ws.u - problem.r));
-      const double shift_change = detail::safeNorm(ws.shift_new - ws.shift);
-      change = shift_change == 0.0 ? 0.0 : shift_change / velocity_scale;
-      ws.shift.swap(ws.shift_new);
-      if (change <= settings_.coulomb_tolerance && outcome.status == Status::Converged) {
-        fixed_point_reached = true;
-        break;
-      }
-    }
-    const bool have_best = best_coulomb < std::numeric_limits<double>::infinity();
-    if (!fixed_point_reached && have_best) {
-      gamma = ws.coulomb_best;
-      outcome.residual = best_inner_residual;
-      // The largest normal velocity of a contact that carries a normal impulse: a separation
-      // the impulses themselves produce (for a converged solve it is zero up to the tolerance).
-      physicalVelocity();
-      double separation = 0.0;
-      for (Eigen::Index i = 0; i < nc; ++i) {
-        if (gamma[3 * i] > 0.0) separation = std::max(separation, ws.u[3 * i]);
-      }
-      result.best_iterate_separation = separation;
-      if (separation > settings_.coulomb_max_separation &&
-          outcome.status != Status::NumericalIssue && !outcome.timed_out) {
-        // Frozen-friction normal correction (see the file comment).
-        ws.zero_mu.setZero();
-        const int shrink_rounds = 10 * settings_.coulomb_outer_iterations;
-        bool settled = false;
-        for (int round = 0; !settled; ++round) {
-          const bool drop = round >= shrink_rounds;  // past the budget: drop, not shrink
-          ws.friction = gamma;
-          for (Eigen::Index i = 0; i < nc; ++i) {
-            ws.friction[3 * i] = 0.0;
-            gamma.segment<2>(3 * i + 1).setZero();
-          }
-          detail::multiplyDelassus(problem, ws.friction, ws.r_normal, ws);
-          ws.r_normal += problem.r;
-          const detail::InnerOutcome normal = inner(ws.r_normal, ws.zero_mu);
-          result.iterations += normal.iterations;
-          result.normal_correction_rounds = round + 1;
-          if (normal.status == Status::NumericalIssue || normal.timed_out) {
-            outcome.status = normal.status;
-            outcome.timed_out = normal.timed_out;
-            outcome.issue = normal.issue;
-            gamma = ws.coulomb_best;  // the best iterate, uncorrected
-            break;
-          }
-          settled = true;
-          for (Eigen::Index i = 0; i < nc; ++i) {
-            Eigen::Ref<Eigen::Vector2d> t = ws.friction.segment<2>(3 * i + 1);
-            const double limit = problem.mu[i] * gamma[3 * i];
-            const double magnitude = t.norm();
-            if (magnitude > limit) {
-              settled = false;
-              if (drop || !(magnitude > 0.0)) {
-                t.setZero();
-                ++result.friction_dropped_contacts;
-              } else {
-                t *= limit / magnitude;
-              }
-            }
-            gamma.segment<2>(3 * i + 1) = t;
-          }
-          outcome.residual = normal.residual;
-        }
-        result.normal_correction_settled = settled;
-        if (settled) {
-          // The corrected impulses may satisfy the Coulomb law to the tolerance themselves.
-          physicalVelocity();
-          const double coulomb =
-              detail::relativeResidual(gamma, ws.u, problem.r, problem.mu, rho, true, ws);
-          if (coulomb <= settings_.tolerance) fixed_point_reached = true;
-        }
-      }
-    }
-    if (fixed_point_reached) outcome.status = Status::Converged;
-    if (outcome.status != Status::NumericalIssue && !outcome.timed_out && !fixed_point_reached) {
-      outcome.status = Status::MaxIterations;
-      result.message = format(
-          "Coulomb fixed point not reached after %g outer iterations: returned the best iterate, "
-          "Coulomb residual %g",
-          result.outer_iterations, best_coulomb);
-    }
+    solveCoulomb(context);
   }
-
-  result.status = outcome.status;
-  if (outcome.status == Status::NumericalIssue && outcome.issue != nullptr) {
-    result.message = outcome.issue;
-  } else if (outcome.timed_out) {
-    result.message = format("time limit of %g s reached", deadline.limit());
-  }
-  physicalVelocity();
-  computeMeasures(gamma, ws.u, problem.r, problem.mu, settings_.residual_rho, ws, result);
-  if (settings_.coulomb_outer_iterations == 0) {
-    result.residual = detail::relativeResidual(gamma, ws.u, problem.r, problem.mu,
-                                               settings_.residual_rho, false, ws);
-  } else {
-    result.residual = outcome.residual;
-  }
-  return finish();
+  finish(context);
+  result.solve_time_s = deadline.elapsed();
+  return result;
 }
 
 }  // namespace rheofeed::ccp

@@ -111,6 +111,12 @@ double relativeResidual(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
                         const Eigen::VectorXd& r, const Eigen::VectorXd& mu, double rho,
                         bool coulomb, Workspace& ws);
 
+/// Fills result's dual_infeasibility, complementarity, objective and coulomb_distance for
+/// impulses gamma with u = N gamma + r (u given). Uses ws.lambda and ws.map.
+void computeMeasures(const Eigen::VectorXd& gamma, const Eigen::VectorXd& u,
+                     const Eigen::VectorXd& r, const Eigen::VectorXd& mu, double rho, Workspace& ws,
+                     Result& result);
+
 /// Projects every contact block of `gamma` onto its friction cone, in place.
 void projectOntoCones(Eigen::VectorXd& gamma, const Eigen::VectorXd& mu);
 

@@ -9,11 +9,11 @@
 
 #include "rheofeed/measure/classical_model.hpp"
 #include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/number_format.hpp"
 
 namespace rheofeed::scene {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // calibrateEfficiency refuses a local drift below this fraction of the peak vibration speed:
 // there the point-mass drift is near a reversal, the ratio amplifies the sample's noise and
 // its sign is arbitrary.
@@ -43,12 +43,6 @@ Scene sampleScene(const Scene& scene, int fixture, int family, int parts, int st
     sample.outputs.axis_direction = v.axis_direction;
   }
   return sample;
-}
-
-std::string show(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
 }
 
 }  // namespace
@@ -176,9 +170,10 @@ EfficiencyCalibration calibrateEfficiency(const Scene& scene, int fixture, int f
     throw std::invalid_argument(
         where + "settings need sample_parts >= 1 (got " + std::to_string(settings.sample_parts) +
         "), steps_per_cycle >= 4 (got " + std::to_string(settings.steps_per_cycle) +
-        "), warmup_cycles >= 0 (got " + show(settings.warmup_cycles) +
-        "), measure_cycles > 0 (got " + show(settings.measure_cycles) +
-        "), rheonomic_time_step in [1e-6, 1] s (got " + show(settings.rheonomic_time_step) + ")");
+        "), warmup_cycles >= 0 (got " + formatNumber(settings.warmup_cycles) +
+        "), measure_cycles > 0 (got " + formatNumber(settings.measure_cycles) +
+        "), rheonomic_time_step in [1e-6, 1] s (got " + formatNumber(settings.rheonomic_time_step) +
+        ")");
   }
   const Vibration& v = scene.fixtures[static_cast<std::size_t>(fixture)].law.vibration;
   const bool reference = settings.use_reference_solver;
@@ -198,7 +193,7 @@ EfficiencyCalibration calibrateEfficiency(const Scene& scene, int fixture, int f
   c.how = std::string("full vibration (") + (reference ? "reference" : "ODE") + ", " +
           std::to_string(settings.steps_per_cycle) + " steps/cycle, " +
           std::to_string(full.parts[0].count) + " parts of '" + full.parts[0].name +
-          "') / local law (h = " + show(settings.rheonomic_time_step) + " s)";
+          "') / local law (h = " + formatNumber(settings.rheonomic_time_step) + " s)";
   const std::clock_t start = std::clock();
   const RunMetrics sampled =
       measureRun(full, reference ? Method::ReferenceFullVibration : Method::OdeFullVibration);
@@ -218,10 +213,11 @@ EfficiencyCalibration calibrateEfficiency(const Scene& scene, int fixture, int f
   if (!(std::abs(c.local) > floor)) {
     throw std::invalid_argument(
         where + "fixtures[" + std::to_string(fixture) + "], part family '" + full.parts[0].name +
-        "': the local law's drift " + show(c.local) + " +- " + show(c.local_ci95) + unit +
-        " is too close to zero (must exceed " + show(floor) + unit +
-        ", the larger of its 95 % half-width and 1 % of the peak vibration speed " + show(peak) +
-        unit + ") for the ratio sampled / local (sampled: " + show(c.sampled) + unit +
+        "': the local law's drift " + formatNumber(c.local) + " +- " + formatNumber(c.local_ci95) +
+        unit + " is too close to zero (must exceed " + formatNumber(floor) + unit +
+        ", the larger of its 95 % half-width and 1 % of the peak vibration speed " +
+        formatNumber(peak) + unit +
+        ") for the ratio sampled / local (sampled: " + formatNumber(c.sampled) + unit +
         ") to mean anything; use drift_model local or calibrated_drift here");
   }
   c.efficiency = c.sampled / c.local;
@@ -231,8 +227,9 @@ EfficiencyCalibration calibrateEfficiency(const Scene& scene, int fixture, int f
   if (!(c.efficiency >= 0 && c.efficiency <= kMaxPartEfficiency)) {
     throw std::invalid_argument(
         where + "fixtures[" + std::to_string(fixture) + "], part family '" + full.parts[0].name +
-        "': efficiency = sampled / local = " + show(c.sampled) + " / " + show(c.local) + " = " +
-        show(c.efficiency) + " must be in [0, " + show(kMaxPartEfficiency) +
+        "': efficiency = sampled / local = " + formatNumber(c.sampled) + " / " +
+        formatNumber(c.local) + " = " + formatNumber(c.efficiency) + " must be in [0, " +
+        formatNumber(kMaxPartEfficiency) +
         "] (a negative ratio: the sample and the local law drift in opposite directions)");
   }
   return c;

@@ -36,7 +36,6 @@
 namespace rheofeed::scene {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kTwoPi = 2 * kPi;
 // Roots of an event function closer than this (rad of phase) to the start of a search are the
 // event just handled, not a new one.

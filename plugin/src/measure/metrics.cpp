@@ -33,8 +33,6 @@ struct Track {
   bool removed = false;   // taken out of the simulation before crossing
 };
 
-constexpr double kPi = 3.14159265358979323846;
-
 // Angle of p about the axis (origin o, unit direction k) in a frame fixed to the axis.
 double angleAbout(const Vec3& p, const Vec3& o, const Vec3& k) {
   Vec3 e1 = std::abs(k.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};

@@ -21,7 +21,9 @@ double studentT95(int dof) {
   if (dof <= 30) return table[dof - 1];
   if (dof <= 60) return 2.042 + (2.000 - 2.042) * (dof - 30) / 30.0;
   if (dof <= 120) return 2.000 + (1.980 - 2.000) * (dof - 60) / 60.0;
-  return 1.96;
+  // Beyond the table the quantile approaches the normal one as 1 / dof (its expansion in 1 / dof
+  // starts z + (z^3 + z) / (4 dof)): interpolating in 120 / dof is what the tables prescribe.
+  return 1.960 + (1.980 - 1.960) * 120.0 / dof;
 }
 
 double ci95(const std::vector<double>& v) {

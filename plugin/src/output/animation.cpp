@@ -23,7 +23,6 @@
 namespace rheofeed::scene {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Tessellation of round shapes: segments around the axis and rings from pole to pole. 24 x 12
 // keeps a sphere's silhouette within 1 - cos(pi / 24) = 0.9 % of its radius.
 constexpr int kSegments = 24;
@@ -377,6 +376,38 @@ void addChannel(tinygltf::Animation& animation, int node, const char* path, int 
   animation.channels.push_back(c);
 }
 
+// The root node: turns the scene's up (-gravity) onto glTF's +y (q = (u x y, 1 + u . y),
+// normalised), and carries the scene's extent (m, scene frame) and the run's facts as extras
+// for viewers (view.html frames the scene with them).
+tinygltf::Node worldRoot(const Scene& scene, const Bounds& extent, double duration, Method method) {
+  tinygltf::Node root;
+  root.name = "rheofeed_world";
+  const Vec3 up = isZero(scene.gravity) ? Vec3{0, 0, 1} : unit(-scene.gravity);
+  const Vec3 y{0, 1, 0};
+  std::array<double, 4> q{};
+  if (dot(up, y) < -1 + 1e-12) {
+    q = {1, 0, 0, 0};  // upside down: half a turn about x
+  } else {
+    const Vec3 axis = cross(up, y);
+    const double w = 1 + dot(up, y);
+    const double n = std::sqrt(dot(axis, axis) + w * w);
+    q = {axis.x / n, axis.y / n, axis.z / n, w / n};
+  }
+  root.rotation = {q[0], q[1], q[2], q[3]};
+  auto triple = [](const Vec3& v) {
+    return tinygltf::Value(
+        tinygltf::Value::Array{tinygltf::Value(v.x), tinygltf::Value(v.y), tinygltf::Value(v.z)});
+  };
+  tinygltf::Value::Object extras;
+  extras["extent_min"] = triple(extent.min);
+  extras["extent_max"] = triple(extent.max);
+  extras["duration_s"] = tinygltf::Value(duration);
+  extras["method"] = tinygltf::Value(std::string(toString(method)));
+  extras["scene"] = tinygltf::Value(scene.name);
+  root.extras = tinygltf::Value(extras);
+  return root;
+}
+
 }  // namespace
 
 AnimationRecorder::AnimationRecorder(const Scene& scene, Method method)
@@ -453,34 +484,7 @@ void AnimationRecorder::write(const std::filesystem::path& path) const {
   ModelWriter writer(model);
   const Bounds extent = sceneLimits(scene_).extent;
 
-  // Root: turns the scene's up (-gravity) onto glTF's +y (q = (u x y, 1 + u . y), normalised).
-  tinygltf::Node root;
-  root.name = "rheofeed_world";
-  const Vec3 up = isZero(scene_.gravity) ? Vec3{0, 0, 1} : unit(-scene_.gravity);
-  const Vec3 y{0, 1, 0};
-  std::array<double, 4> q{};
-  if (dot(up, y) < -1 + 1e-12) {
-    q = {1, 0, 0, 0};  // upside down: half a turn about x
-  } else {
-    const Vec3 axis = cross(up, y);
-    const double w = 1 + dot(up, y);
-    const double n = std::sqrt(dot(axis, axis) + w * w);
-    q = {axis.x / n, axis.y / n, axis.z / n, w / n};
-  }
-  root.rotation = {q[0], q[1], q[2], q[3]};
-  // The scene's extent (m, scene frame) and run facts, for viewers (view.html frames it).
-  auto triple = [](const Vec3& v) {
-    return tinygltf::Value(
-        tinygltf::Value::Array{tinygltf::Value(v.x), tinygltf::Value(v.y), tinygltf::Value(v.z)});
-  };
-  tinygltf::Value::Object extras;
-  extras["extent_min"] = triple(extent.min);
-  extras["extent_max"] = triple(extent.max);
-  extras["duration_s"] = tinygltf::Value(duration());
-  extras["method"] = tinygltf::Value(std::string(toString(method_)));
-  extras["scene"] = tinygltf::Value(scene_.name);
-  root.extras = tinygltf::Value(extras);
-  model.nodes.push_back(root);
+  model.nodes.push_back(worldRoot(scene_, extent, duration(), method_));
 
   const double grey[3] = {kFixtureGrey, kFixtureGrey, kFixtureGrey};
   const int fixture_material = addMaterial(model, "fixture", grey);

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/output/plot.hpp"
 
 namespace rheofeed::scene {
@@ -61,9 +62,7 @@ namespace {
 // A number for JSON: %.8g, null when not finite.
 std::string jsonNumber(double x) {
   if (!std::isfinite(x)) return "null";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.8g", x);
-  return b;
+  return formatNumber(x, 8);
 }
 
 // The JSON keys of the families: the name, or "name[k]" when an earlier family has that name.

@@ -38,7 +38,7 @@ std::string summaryJson(const RunMetrics& r) {
   for (std::size_t k = 0; k < r.drift_models.size(); ++k) {
     run += (k ? ", " : "") + jsonQuoted(r.drift_models[k]);
   }
-  run += "]";
+  run += "], \"friction\": " + jsonQuoted(r.health.friction_model);
   const RunHealth& h = r.health;
   char c[1536];
   std::snprintf(

@@ -15,12 +15,12 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "rheofeed/number_format.hpp"
+
 namespace rheofeed::scene {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr double kPi = 3.14159265358979323846;
 
 // A closed surface has zero total area vector. Merged vertices close it to rounding error
 // (~1e-7 relative with the single-precision coordinates of STL files); a CAD export whose
@@ -34,13 +34,6 @@ std::string quoted(const std::string& s) {
 
 std::string nameOf(const TriangleMesh& mesh) {
   return mesh.source.empty() ? std::string("mesh") : "mesh " + quoted(mesh.source);
-}
-
-std::string number(double v) {
-  std::ostringstream out;
-  out.precision(6);
-  out << v;
-  return out.str();
 }
 
 void checkIndices(const TriangleMesh& mesh) {
@@ -78,7 +71,7 @@ Vec3 vertex(const TriangleMesh& mesh, int index) {
 TriangleMesh loadTriangleMesh(const fs::path& file, double scale) {
   const std::string name = "mesh " + quoted(file.string());
   if (!(std::isfinite(scale) && scale > 0)) {
-    throw std::invalid_argument(name + ": scale = " + number(scale) +
+    throw std::invalid_argument(name + ": scale = " + formatNumber(scale) +
                                 " must be a finite number > 0");
   }
   // Kind and size from stat first: a FIFO, a device or a directory is never opened.
@@ -121,7 +114,7 @@ TriangleMesh loadTriangleMesh(const fs::path& file, double scale) {
         if (!std::isfinite(xyz[k])) {
           throw std::invalid_argument(name + ": vertex " + std::to_string(offset + v) +
                                       " has a non-finite coordinate (" + std::string(1, "xyz"[k]) +
-                                      " = " + number(xyz[k]) + " m)");
+                                      " = " + formatNumber(xyz[k]) + " m)");
         }
       }
       mesh.vertices.insert(mesh.vertices.end(), xyz, xyz + 3);
@@ -140,7 +133,7 @@ TriangleMesh loadTriangleMesh(const fs::path& file, double scale) {
 MassProperties massProperties(const TriangleMesh& mesh, double density) {
   const std::string name = nameOf(mesh);
   if (!(std::isfinite(density) && density > 0)) {
-    throw std::invalid_argument(name + ": density = " + number(density) +
+    throw std::invalid_argument(name + ": density = " + formatNumber(density) +
                                 " must be a finite number > 0");
   }
   checkIndices(mesh);
@@ -175,12 +168,12 @@ MassProperties massProperties(const TriangleMesh& mesh, double density) {
   const double residual = 0.5 * norm(area_vector);
   if (!(residual <= kClosureTolerance * area)) {
     throw std::invalid_argument(name + ": the surface is not closed (its area vectors sum to " +
-                                number(residual / area * 100) +
+                                formatNumber(residual / area * 100) +
                                 " % of its area); a solid needs a watertight mesh");
   }
   const double volume = six_volume / 6;
   if (!(volume > 0)) {
-    throw std::invalid_argument(name + ": signed volume " + number(volume) +
+    throw std::invalid_argument(name + ": signed volume " + formatNumber(volume) +
                                 " m^3 <= 0: the mesh is open or inside out (triangles must be "
                                 "counter-clockwise seen from outside)");
   }
@@ -192,9 +185,10 @@ MassProperties massProperties(const TriangleMesh& mesh, double density) {
   }
   const double sphere = 4.0 / 3.0 * kPi * r2 * std::sqrt(r2);
   if (!(volume >= limits::kMinVolumeFraction * sphere)) {
-    throw std::invalid_argument(name + ": degenerate solid: volume " + number(volume) + " m^3 is " +
-                                number(volume / sphere) + " of its bounding sphere's; at least " +
-                                number(limits::kMinVolumeFraction) + " is needed for a part");
+    throw std::invalid_argument(name + ": degenerate solid: volume " + formatNumber(volume) +
+                                " m^3 is " + formatNumber(volume / sphere) +
+                                " of its bounding sphere's; at least " +
+                                formatNumber(limits::kMinVolumeFraction) + " is needed for a part");
   }
 
   MassProperties out;

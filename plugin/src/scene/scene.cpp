@@ -10,13 +10,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/scene/mesh.hpp"
 #include "scene_limits.hpp"
 
 namespace rheofeed::scene {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Truncated normal sizes are redrawn this many times before the value is clamped.
 constexpr int kRedraws = 100;
 // Attempts to place a part spawned at t = 0 without overlapping earlier ones.
@@ -29,9 +29,7 @@ constexpr int kPlacementTries = 200;
 }
 
 std::string show(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
+  return formatNumber(v);
 }
 
 void positive(const std::string& path, double v) {
@@ -288,6 +286,11 @@ void Scene::validate() const {
         "must be in [1, " + std::to_string(limits::kMaxIterations) + "]");
   }
   if (!(solver.erp >= 0 && solver.erp <= 1)) bad("solver.erp", solver.erp, "must be in [0, 1]");
+  if (solver.friction == FrictionModel::Cone && !solver.ode_quickstep) {
+    throw std::invalid_argument(
+        "solver.friction = \"cone\" needs solver.ode_quickstep = true: dWorldStep (the Dantzig "
+        "LCP) cannot express a friction cone; use \"pyramid\" or quickstep");
+  }
   nonNegative("solver.cfm", solver.cfm);
   positive("solver.max_correcting_velocity", solver.max_correcting_velocity);
   within("solver.max_correcting_velocity", solver.max_correcting_velocity, 0, limits::kMaxSpeed,

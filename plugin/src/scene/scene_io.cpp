@@ -568,6 +568,17 @@ Scene readScene(const json& root) {
     m.opt("rheonomic_time_step", x.rheonomic_time_step, Range::NonNegative);
     m.opt("iterations", x.iterations, 1);
     m.opt("ode_quickstep", x.ode_quickstep);
+    std::string friction;
+    if (m.opt("friction", friction)) {
+      FrictionModel model;
+      if (!parseFrictionModel(friction.c_str(), model)) {
+        const std::string typo = closest(friction, {"cone", "pyramid"});
+        fail(m.at("friction"), "unknown friction model \"" + friction + "\"" +
+                                   (typo.empty() ? "" : " (did you mean \"" + typo + "\"?)") +
+                                   "; expected cone or pyramid");
+      }
+      x.friction = model;
+    }
     m.opt("erp", x.erp, Range::UnitInterval);
     m.opt("cfm", x.cfm, Range::NonNegative);
     m.opt("tolerance", x.tolerance, Range::Positive);

@@ -78,14 +78,4 @@ dGeomID createGeom(dSpaceID space, const Shape& s, TriMeshStore& meshes) {
   throw std::invalid_argument("unknown shape kind");
 }
 
-void setGeomPose(dGeomID geom, const Pose& pose) {
-  dGeomSetPosition(geom, pose.position.x, pose.position.y, pose.position.z);
-  dMatrix3 r;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) r[4 * i + j] = pose.rotation[3 * i + j];
-    r[4 * i + 3] = 0;
-  }
-  dGeomSetRotation(geom, r);
-}
-
 }  // namespace rheofeed::scene

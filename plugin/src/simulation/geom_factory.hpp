@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "ode_vec.hpp"  // setGeomPose and the other ODE <-> rheofeed conversions
 #include "rheofeed/scene/scene.hpp"
 
 namespace rheofeed::scene {
@@ -43,8 +44,5 @@ class TriMeshStore {
 /// with their ODE data owned by `meshes`; a mesh shape without mesh_data throws
 /// std::invalid_argument.
 dGeomID createGeom(dSpaceID space, const Shape& shape, TriMeshStore& meshes);
-
-/// Sets a placeable geom's world pose.
-void setGeomPose(dGeomID geom, const Pose& pose);
 
 }  // namespace rheofeed::scene

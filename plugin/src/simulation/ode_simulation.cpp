@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "geom_factory.hpp"
+#include "ode_vec.hpp"
 #include "rheofeed/contact_collider.hpp"
 #include "rheofeed/feeder_set.hpp"
 #include "rheofeed/reference/world.hpp"
@@ -36,7 +37,11 @@ class OdeSimulation final : public PartSimulation {
     dWorldSetContactMaxCorrectingVel(world_, scene.solver.max_correcting_velocity);
     dWorldSetContactSurfaceLayer(world_, scene.solver.surface_layer);
     space_ = dHashSpaceCreate(nullptr);
-    feeders_ = std::make_unique<FeederSet>();
+    const FrictionModel friction = odeFrictionModel(scene.solver);
+    health_.friction_model = toString(friction);
+    FeederSet::Options options;
+    options.friction = friction;
+    feeders_ = std::make_unique<FeederSet>(options);
 
     for (std::size_t fi = 0; fi < scene.fixtures.size(); ++fi) {
       const Fixture& f = scene.fixtures[fi];
@@ -57,7 +62,7 @@ class OdeSimulation final : public PartSimulation {
           dGeomSetOffsetWorldPosition(geom, g.pose.position.x, g.pose.position.y,
                                       g.pose.position.z);
           dMatrix3 r;
-          toOdeMatrix(g.pose, r);
+          toOdeMatrix(g.pose.rotation, r);
           dGeomSetOffsetWorldRotation(geom, r);
         } else if (f.law.kind != FeederLaw::Kind::None) {
           feeders_->add(geom, law);
@@ -68,11 +73,14 @@ class OdeSimulation final : public PartSimulation {
 
     ContactCollider::Settings cs;
     cs.feedback = true;
+    cs.friction = friction;
     collider_ = std::make_unique<ContactCollider>(world_, *feeders_, cs);
     const double mu = scene.material.mu, bounce = scene.material.restitution;
-    collider_->setSurfaceCallback([mu, bounce](dGeomID, dGeomID, dContact* c, int n) {
+    const int mode =
+        withFrictionModel(dContactApprox1 | (bounce > 0 ? dContactBounce : 0), friction);
+    collider_->setSurfaceCallback([mu, bounce, mode](dGeomID, dGeomID, dContact* c, int n) {
       for (int i = 0; i < n; ++i) {
-        c[i].surface.mode = dContactApprox1 | (bounce > 0 ? dContactBounce : 0);
+        c[i].surface.mode = mode;
         c[i].surface.mu = mu;
         c[i].surface.bounce = bounce;
         c[i].surface.bounce_vel = 0;
@@ -109,13 +117,10 @@ class OdeSimulation final : public PartSimulation {
   PartState partState(int i) const override {
     dBodyID b = parts_.at(static_cast<std::size_t>(i));
     PartState s;
-    s.position = vec(dBodyGetPosition(b));
-    s.velocity = vec(dBodyGetLinearVel(b));
-    s.angular_velocity = vec(dBodyGetAngularVel(b));
-    const dReal* r = dBodyGetRotation(b);
-    for (int row = 0; row < 3; ++row) {
-      for (int col = 0; col < 3; ++col) s.rotation[3 * row + col] = r[4 * row + col];
-    }
+    s.position = toVec3(dBodyGetPosition(b));
+    s.velocity = toVec3(dBodyGetLinearVel(b));
+    s.angular_velocity = toVec3(dBodyGetAngularVel(b));
+    fromOdeMatrix(dBodyGetRotation(b), s.rotation);
     return s;
   }
 
@@ -133,16 +138,6 @@ class OdeSimulation final : public PartSimulation {
   }
 
  private:
-  static Vec3 vec(const dReal* a) { return {a[0], a[1], a[2]}; }
-  // A row-major 3x3 rotation (body to world) as ODE's 3x4 matrix.
-  static void toOdeMatrix(const double rotation[9], dMatrix3 r) {
-    for (int row = 0; row < 3; ++row) {
-      for (int col = 0; col < 3; ++col) r[4 * row + col] = rotation[3 * row + col];
-      r[4 * row + 3] = 0;
-    }
-  }
-  static void toOdeMatrix(const Pose& p, dMatrix3 r) { toOdeMatrix(p.rotation, r); }
-
   // ODE's generator is 32 bits wide: the scene seed mixed (splitmix64) and cut to 32 bits.
   static unsigned long randomSeed(std::uint64_t seed) {
     std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL;
@@ -178,11 +173,11 @@ class OdeSimulation final : public PartSimulation {
     const Pose p0 = v.displacement(t), p1 = v.displacement(t + h);
     dBodySetPosition(body, p0.position.x, p0.position.y, p0.position.z);
     dMatrix3 r;
-    toOdeMatrix(p0, r);
+    toOdeMatrix(p0.rotation, r);
     dBodySetRotation(body, r);
     const Vec3 lin = (1.0 / h) * (p1.position - p0.position);
     dBodySetLinearVel(body, lin.x, lin.y, lin.z);
-    const Vec3 ang = reference::secantAngularVelocity(p0, p1, h);
+    const Vec3 ang = secantAngularVelocity(p0, p1, h);
     dBodySetAngularVel(body, ang.x, ang.y, ang.z);
   }
 
@@ -194,7 +189,7 @@ class OdeSimulation final : public PartSimulation {
     dBodySetMass(b, &m);
     dBodySetPosition(b, p.pose.position.x, p.pose.position.y, p.pose.position.z);
     dMatrix3 r;
-    toOdeMatrix(p.pose, r);
+    toOdeMatrix(p.pose.rotation, r);
     dBodySetRotation(b, r);
     dBodySetLinearVel(b, p.velocity.x, p.velocity.y, p.velocity.z);
     dGeomID geom = createGeom(space_, p.shape, meshes_);
@@ -213,7 +208,7 @@ class OdeSimulation final : public PartSimulation {
       const dGeomID part = f1 ? j.g2 : j.g1;
       const dBodyID body = dGeomGetBody(part);
       const dReal* f = dJointGetBody(j.joint, 0) == body ? j.feedback->f1 : j.feedback->f2;
-      const Vec3 impulse = h * vec(f);
+      const Vec3 impulse = h * toVec3(f);
       const Vec3 n_into_part = part == j.g1 ? j.normal : -j.normal;
       ++totals.count;
       totals.normal_impulse += dot(impulse, n_into_part);

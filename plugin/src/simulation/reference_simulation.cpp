@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "geom_factory.hpp"
 #include "rheofeed/reference/world.hpp"
+#include "rheofeed/simulation/reference_simulation.hpp"
 #include "simulation_internal.hpp"
 
 namespace rheofeed::scene {
@@ -15,7 +18,8 @@ using reference::BodyId;
 
 class ReferenceSimulation final : public PartSimulation {
  public:
-  ReferenceSimulation(const Scene& scene, Method method) : PartSimulation(scene, method) {
+  ReferenceSimulation(const Scene& scene, Method method, reference::StepObserver observer)
+      : PartSimulation(scene, method) {
     reference::Settings s;
     s.gravity = scene.gravity;
     s.erp = scene.solver.erp;
@@ -30,6 +34,7 @@ class ReferenceSimulation final : public PartSimulation {
     s.max_correcting_velocity = scene.solver.max_correcting_velocity;
     s.surface_layer = scene.solver.surface_layer;
     world_ = std::make_unique<reference::World>(s);
+    world_->setStepObserver(std::move(observer));
 
     for (std::size_t fi = 0; fi < scene.fixtures.size(); ++fi) {
       const Fixture& f = scene.fixtures[fi];
@@ -163,6 +168,11 @@ class ReferenceSimulation final : public PartSimulation {
   // Settings of the scene the reference world does not read, when they differ from their
   // defaults.
   void listIgnoredSettings() {
+    health_.friction_model = "cone";
+    if (scene_.solver.friction == FrictionModel::Pyramid) {
+      ignoreSetting(
+          "solver.friction = pyramid: ignored by the reference solver (it solves the cone)");
+    }
     if (!scene_.solver.ode_quickstep) {
       ignoreSetting(
           "solver.ode_quickstep = false: ignored by the reference solver (ODE's stepper choice)");
@@ -177,7 +187,18 @@ class ReferenceSimulation final : public PartSimulation {
 }  // namespace
 
 std::unique_ptr<Simulation> makeReferenceSimulation(const Scene& scene, Method method) {
-  return std::make_unique<ReferenceSimulation>(scene, method);
+  return std::make_unique<ReferenceSimulation>(scene, method, reference::StepObserver{});
+}
+
+std::unique_ptr<Simulation> makeObservedReferenceSimulation(const Scene& scene, Method method,
+                                                            reference::StepObserver observer) {
+  if (method != Method::ReferenceRheonomic && method != Method::ReferenceFullVibration) {
+    throw std::invalid_argument(
+        "makeObservedReferenceSimulation: method " + std::string(toString(method)) +
+        " is not a reference method (reference_rheonomic, reference_full_vibration)");
+  }
+  scene.validate();
+  return std::make_unique<ReferenceSimulation>(scene, method, std::move(observer));
 }
 
 }  // namespace rheofeed::scene

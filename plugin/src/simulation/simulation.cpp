@@ -66,7 +66,6 @@ namespace rheofeed::scene {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinMargin = 1.0;             // m: smallest margin around the scene's extent
 constexpr double kTunnelCheckFraction = 1e-3;  // of the smallest half-size, see above
 // Two crossings along one segment are distinct when they are this far apart (m): far below any
@@ -640,6 +639,22 @@ PartState PartSimulation::part(int index) const {
 
 double PartSimulation::partMass(int index) const {
   return instances_.at(static_cast<std::size_t>(index)).mass;
+}
+
+FrictionModel odeFrictionModel(const SolverSettings& solver) {
+  if (!solver.friction) {
+    return solver.ode_quickstep && odeHasFrictionCone() ? FrictionModel::Cone
+                                                        : FrictionModel::Pyramid;
+  }
+  if (*solver.friction == FrictionModel::Cone) {
+    if (!solver.ode_quickstep) {
+      throw std::invalid_argument(
+          "solver.friction = \"cone\" needs solver.ode_quickstep = true: dWorldStep (the "
+          "Dantzig LCP) cannot express a friction cone");
+    }
+    requireFrictionModel(FrictionModel::Cone, "solver.friction");
+  }
+  return *solver.friction;
 }
 
 std::unique_ptr<Simulation> makeSimulation(const Scene& scene, Method method) {

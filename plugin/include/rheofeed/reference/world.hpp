@@ -54,12 +54,21 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/ccp/problem.hpp"
-#include "rheofeed/ccp/solver.hpp"
+#include "rheofeed/ccp/settings.hpp"
 #include "rheofeed/motion_law.hpp"
 #include "rheofeed/vec3.hpp"
 
+namespace rheofeed::ccp {
+struct Problem;
+}
+
 namespace rheofeed::reference {
+
+struct WorldState;
+class World;
+
+/// The contact problem of `world`'s last step with contacts (contact_problem.hpp).
+const ccp::Problem& lastContactProblem(const World& world);
 
 /// Index of a body in a World (0, 1, ...). kStatic means "no body" (the static environment).
 using BodyId = int;
@@ -70,9 +79,6 @@ struct Quat {
   double w = 1, x = 0, y = 0, z = 0;
 };
 
-/// Angular velocity (rad/s, world) that turns p0's rotation into p1's in h seconds (the
-/// secant of a prescribed rotation, as given to kinematic bodies).
-Vec3 secantAngularVelocity(const Pose& p0, const Pose& p1, double h);
 /// The rotation of a pose as a unit quaternion, and back (row-major matrix, body to world).
 Quat toQuat(const Pose& pose);
 Pose toPose(const Quat& q, const Vec3& position = {});
@@ -101,6 +107,18 @@ struct ContactImpulse {
   double normal_velocity = 0;  ///< u_n after the step (m/s), > 0 separating
 };
 
+/// Which method solves the true Coulomb law in the reference world.
+enum class CoulombSolver {
+  /// Nonsmooth Gauss-Seidel with exact local Coulomb solves (ccp/nsgs.hpp).
+  Nsgs,
+  /// The relaxed CCP inside the outer fixed point on De Saxce's shift (ccp/solver.hpp), with
+  /// the frozen-friction normal correction when it does not settle.
+  RelaxedFixedPoint,
+};
+
+/// Printable name of a CoulombSolver ("NSGS", "RelaxedFixedPoint").
+const char* toString(CoulombSolver solver);
+
 /// Settings of the reference world, with ODE's defaults where ODE has one.
 struct Settings {
   Vec3 gravity{0, 0, -9.81};  ///< (m/s^2)
@@ -117,14 +135,37 @@ struct Settings {
   double restitution = 0.0;
   /// Minimum approach speed for a bounce (m/s, >= 0), as ODE's surface.bounce_vel.
   double bounce_velocity = 0.0;
-  bool warm_start = true;  ///< reuse last step's impulses per (pair, index)
-  ccp::Settings solver;    ///< the CCP solver's settings
+  /// Start each step's solve from the last step's impulses: a contact takes the impulse
+  /// (world frame, re-expressed in its new contact frame) of the nearest unclaimed contact of
+  /// the same geom pair in the last step, if that lies within warm_start_distance.
+  bool warm_start = true;
+  /// Largest distance (m, finite, >= 0) between a contact point and last step's contact point of
+  /// the same geom pair for the warm start to match them (parts move ~|v| h per step).
+  double warm_start_distance = 2e-3;
+  ccp::Settings solver;  ///< the CCP solver's settings (relaxed mode and the fixed point)
+  /// Solver of the true Coulomb mode (solver.coulomb_outer_iterations > 0): NSGS (default)
+  /// or the relaxed solver inside the De Saxce fixed point (ccp::Settings). 0 outer iterations
+  /// always solve the relaxed CCP with `solver`.
+  CoulombSolver coulomb_solver = CoulombSolver::Nsgs;
+  /// NSGS settings for coulomb_solver == Nsgs. Its tolerance, residual_rho and time limit are
+  /// taken from `solver` (tolerance: the Coulomb tolerance of the step); the rest as given.
+  ccp::NsgsSettings nsgs;
+  /// NSGS: visit the contacts from the highest to the lowest along -gravity (the order of the
+  /// contact problem), so that a sweep carries a pile's weight down in one pass; false keeps
+  /// the collision order.
+  bool nsgs_top_down = true;
   /// Use the dense Delassus matrix up to this many contacts, matrix-free above.
   int dense_contact_limit = 100;
 };
 
 /// Friction coefficient for a pair of geoms (dimensionless, >= 0).
 using FrictionCallback = std::function<double(dGeomID g1, dGeomID g2)>;
+
+struct StepReport;
+/// Called by World::step at the end of every step (after integration), with the world and the
+/// step's report: lastContactProblem(world) is then the step's contact problem. It may read
+/// the world but not step it; an exception it throws leaves World::step.
+using StepObserver = std::function<void(const World& world, const StepReport& report)>;
 
 /// What one step did.
 struct StepReport {
@@ -134,14 +175,15 @@ struct StepReport {
   /// status NotRun when there was no contact. NumericalIssue also when non-finite impulses
   /// had to be dropped (they are never integrated).
   ccp::Result solve;
-  /// True when the true-Coulomb fixed point (Settings::solver.coulomb_outer_iterations > 0) did
-  /// not settle (solve.status MaxIterations) and the step used the solver's best Coulomb
-  /// iterate, the one with the lowest Coulomb residual (never the relaxed CCP's separation
-  /// at mu |u_t|). If that iterate separates a contact carrying a normal impulse faster than
-  /// max(solver.coulomb_max_separation, 0.01 |g| h) (m/s), its normal impulses are corrected
-  /// with its friction frozen and shrunk into the cone (ccp::Result::normal_correction_rounds,
-  /// friction_dropped_contacts, best_iterate_separation), so friction cannot launch a part.
-  /// Count it over a run to know how often the law was only approximated.
+  /// True when the true-Coulomb fixed point (Settings::solver.coulomb_outer_iterations > 0 with
+  /// coulomb_solver RelaxedFixedPoint) did not settle (solve.status MaxIterations) and the step
+  /// used the solver's best Coulomb iterate, the one with the lowest Coulomb residual (never the
+  /// relaxed CCP's separation at mu |u_t|). If that iterate separates a contact carrying a normal
+  /// impulse faster than max(solver.coulomb_max_separation, 0.01 |g| h) (m/s), its normal impulses
+  /// are corrected with its friction frozen and shrunk into the cone
+  /// (ccp::Result::normal_correction_rounds, friction_dropped_contacts, best_iterate_separation),
+  /// so friction cannot launch a part. Count it over a run to know how often the law was only
+  /// approximated.
   bool coulomb_fallback = false;
   /// Natural map residual of the true Coulomb law for the impulses applied this step
   /// (dimensionless, scaled by 1 + |r| as ccp::Result::coulomb_distance; NaN without contacts).
@@ -190,6 +232,8 @@ class World {
   void setBodyEfficiency(BodyId body, double factor);
   /// Per-pair friction coefficient (default: Settings::default_mu everywhere).
   void setFrictionCallback(FrictionCallback callback);
+  /// Observer of every step (none by default; an empty function removes it).
+  void setStepObserver(StepObserver observer);
   /// External force (N) and torque (N m) on a body for the next step only (world frame).
   void addForce(BodyId body, const Vec3& force, const Vec3& torque = {});
 
@@ -210,12 +254,10 @@ class World {
   const std::vector<ContactImpulse>& contacts() const;
   /// Settings; changes apply from the next step.
   Settings& settings();
-  /// The contact problem of the last step with contacts (for benchmarks and inspection).
-  const ccp::Problem& lastProblem() const;
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  friend const ccp::Problem& lastContactProblem(const World& world);
+  std::unique_ptr<WorldState> impl_;  // world_internal.hpp
 };
 
 }  // namespace rheofeed::reference

@@ -135,6 +135,9 @@ struct RunHealth {
   /// point-mass model runs. Informative, not a loss: not part of anything().
   int local_law_feeders = 0;
   LocalDriftStats local_law;
+  /// The friction law the engine solved ("cone" or "pyramid"; odeFrictionModel for ODE, the
+  /// reference engine always "cone"). Recorded in the run JSON.
+  std::string friction_model;
   /// Parts lost in any way but the exit: fell + through_fixture + left_feeder + out_of_bounds +
   /// nonfinite + too_fast, plus those inside a fixture now.
   int partsLost() const {
@@ -262,5 +265,11 @@ class Simulation {
 /// thread do not disturb each other or the application. Simulations stepped concurrently in
 /// several threads do share (and race on) that global.
 std::unique_ptr<Simulation> makeSimulation(const Scene& scene, Method method);
+
+/// The friction law an ODE run of a scene with these settings solves: solver.friction when
+/// given, else the cone where the linked ODE has it (odeHasFrictionCone: rheofeed's patched
+/// ODE) and solver.ode_quickstep is true, else the pyramid. Throws std::invalid_argument naming
+/// solver.friction for the cone with ode_quickstep = false or on an ODE without the cone.
+FrictionModel odeFrictionModel(const SolverSettings& solver);
 
 }  // namespace rheofeed::scene

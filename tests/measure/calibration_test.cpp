@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: MIT
+// calibration.cpp on a case with a known answer: a flat track vibrating at 30 degrees with
+// throw number 3.4, where the classical single-part model has a closed form (NOTES section 5;
+// tests/validation/classical_model_test.cpp derives it): the part hops for exactly one cycle and
+// leaves the track at the track's velocity at the phase cos(phi) = pi / Gamma, so it drifts at
+// A w cos(beta) pi / Gamma = pi g cot(beta) / w.
+#include "rheofeed/measure/calibration.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+#include "scene_builders.hpp"
+
+namespace rheofeed::scene {
+namespace {
+
+constexpr double kG = 9.81;              // m/s^2
+constexpr double kBeta = kPi / 6;        // vibration angle above the track, 30 degrees
+constexpr double kThrowNumber = 3.4;     // Gamma = A w^2 sin(beta) / g
+constexpr double kFrequency = 50;        // Hz
+const double kW = 2 * kPi * kFrequency;  // rad/s
+const double kAmplitude = kThrowNumber * kG / (kW * kW * std::sin(kBeta));  // m
+// The model integrates the flight in closed form and finds the landing by root finding to
+// rounding: the closed form holds to 1e-9 relative (as in classical_model_test.cpp).
+constexpr double kClosedForm = 1e-9;
+
+Scene hoppingTrack() {
+  Scene s;
+  s.name = "one-cycle hop";
+  s.fixtures.push_back(test::vibratingBox("track", {0.4, 0.1, 0.02}, {0, 0, 0}, kAmplitude,
+                                          kFrequency, {std::cos(kBeta), 0, std::sin(kBeta)}));
+  PartSpec p;
+  p.name = "flat_box";
+  p.size[0].mean = 0.02;
+  p.size[1].mean = 0.02;
+  p.size[2].mean = 0.005;
+  p.density = 2700;
+  p.spawn_min = {-0.05, -0.02, 0.0025};
+  p.spawn_max = {0.05, 0.02, 0.0025};
+  p.count = 4;
+  s.parts.push_back(p);
+  s.material.mu = 0.5;
+  s.gravity = {0, 0, -kG};
+  s.solver.time_step = 0.01;
+  s.duration = 0.5;
+  s.outputs.conveying_direction = {1, 0, 0};
+  return s;
+}
+
+TEST(CalibrateClassical, OneCycleHopDriftsAtPiGCotBetaOverOmega) {
+  const Scene s = hoppingTrack();
+  const Calibration c = calibrateClassical(s, 0);
+  const double expected = kPi * kG / std::tan(kBeta) / kW;  // 0.1700 m/s
+  EXPECT_EQ(c.fixture, 0);
+  EXPECT_NEAR(c.value, expected, kClosedForm * expected);
+  EXPECT_EQ(c.ci95, 0.0);  // a model, not a sample
+  // A translation along the conveying direction, no rotation.
+  EXPECT_NEAR(c.drift.linear.x, expected, kClosedForm * expected);
+  EXPECT_EQ(c.drift.linear.y, 0.0);
+  EXPECT_EQ(c.drift.linear.z, 0.0);
+  EXPECT_TRUE(isZero(c.drift.angular));
+  // Efficiency: drift over the peak track velocity along the track, A w cos(beta) = pi / Gamma.
+  EXPECT_NEAR(c.efficiency, kPi / kThrowNumber, kClosedForm);
+}
+
+TEST(CalibrateClassical, TheConveyingDirectionSetsTheSignOfTheDrift) {
+  Scene s = hoppingTrack();
+  s.outputs.conveying_direction = {-1, 0, 0};  // measured against the motion
+  const double expected = kPi * kG / std::tan(kBeta) / kW;
+  const Calibration c = calibrateClassical(s, 0);
+  EXPECT_NEAR(c.value, -expected, kClosedForm * expected);
+  // The drift field itself does not depend on how it is measured.
+  EXPECT_NEAR(c.drift.linear.x, expected, kClosedForm * expected);
+}
+
+TEST(CalibrateClassical, RefusesAFixtureThatDoesNotVibrateNamingIt) {
+  Scene s = hoppingTrack();
+  s.fixtures.push_back(test::boxFixture("floor", {1, 1, 0.01}, {0, 0, -0.2}));
+  for (int fixture : {1, 2, -1}) {
+    try {
+      calibrateClassical(s, fixture);
+      ADD_FAILURE() << "fixture " << fixture << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("fixtures[" + std::to_string(fixture) + "]"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+TEST(WithCalibration, StoresTheDriftAndSwitchesTheFixtureToIt) {
+  const Scene s = hoppingTrack();
+  const Calibration c = calibrateClassical(s, 0);
+  const Scene calibrated = withCalibration(s, c);
+  const FeederLaw& law = calibrated.fixtures[0].law;
+  EXPECT_TRUE(law.has_calibrated_drift);
+  EXPECT_EQ(law.drift_model, DriftModel::CalibratedDrift);
+  EXPECT_EQ(law.calibrated_drift.linear, c.drift.linear);
+  EXPECT_NO_THROW(calibrated.validate());
+  Calibration wrong = c;
+  wrong.fixture = 3;
+  EXPECT_THROW(withCalibration(s, wrong), std::invalid_argument);
+}
+
+TEST(CalibrateScene, CalibratesOnlyTheFixturesWhoseDriftModelTakesACalibration) {
+  Scene s = hoppingTrack();
+  std::FILE* log = std::tmpfile();
+  ASSERT_NE(log, nullptr);
+  CalibrateOptions options;
+  options.classical = true;
+  Scene local = s;  // the default drift model, the local law: nothing to calibrate
+  const CalibrateReport none = calibrateScene(local, options, "test", log);
+  EXPECT_EQ(none.calibrated, 0);
+  EXPECT_EQ(none.local, 1);
+  EXPECT_FALSE(local.fixtures[0].law.has_calibrated_drift);
+
+  s.fixtures[0].law.drift_model = DriftModel::CalibratedDrift;
+  const CalibrateReport report = calibrateScene(s, options, "test", log);
+  EXPECT_EQ(report.calibrated, 1);
+  EXPECT_EQ(report.given, 0);
+  const double expected = kPi * kG / std::tan(kBeta) / kW;
+  EXPECT_TRUE(s.fixtures[0].law.has_calibrated_drift);
+  EXPECT_NEAR(s.fixtures[0].law.calibrated_drift.linear.x, expected, kClosedForm * expected);
+  // Calibrated once, the scene gives it: a second pass leaves it.
+  const CalibrateReport again = calibrateScene(s, options, "test", log);
+  EXPECT_EQ(again.calibrated, 0);
+  EXPECT_EQ(again.given, 1);
+  std::fclose(log);
+}
+
+}  // namespace
+}  // namespace rheofeed::scene

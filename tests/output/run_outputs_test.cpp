@@ -1,0 +1,193 @@
+// SPDX-License-Identifier: MIT
+// run_outputs.cpp: a run's series CSV and JSON summary read back (the JSON with nlohmann-json)
+// and compared with the RunMetrics written; writeRunOutputs leaves complete files only.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "rheofeed/output/output.hpp"
+
+namespace rheofeed::scene {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Drift numbers are printed with eight significant digits (%.8g): half a unit of the eighth.
+constexpr double kEightDigits = 5e-8;
+// Times in the CSV have six decimals (%.6f), in seconds.
+constexpr double kSixDecimals = 5e-7;
+// Counters of the health object are printed with six significant digits (%.6g).
+constexpr double kSixDigits = 5e-6;
+
+RunMetrics run() {
+  RunMetrics r;
+  r.scene = "trough \"A\"";
+  r.method = Method::ReferenceRheonomic;
+  r.time_step = 0.01;
+  r.seed = std::numeric_limits<std::uint64_t>::max();  // every bit of the seed survives
+  r.drift_models = {"track: local", "bowl: calibrated_drift"};
+  r.angular = false;
+  DriftSample a;
+  a.time = 0.5;
+  a.parts = 12;
+  a.mean_velocity = 0.0123456789;
+  a.ci95 = 0.00087654321;
+  a.mean_height = 0.0051;
+  a.exited = 1;
+  a.fell = 2;
+  DriftSample b = a;
+  b.time = 1.0;
+  b.parts = 11;
+  b.mean_velocity = -0.002;
+  b.through_fixture = 1;
+  b.out_of_bounds = 3;
+  b.nonfinite = 4;
+  b.too_fast = 5;
+  r.series = {a, b};
+  r.mean_drift = 0.0234567891;
+  r.mean_drift_ci95 = 0.0012345678;
+  r.vertical_displacement = -0.0004;
+  r.throughput = 1.5;
+  r.parts = 12;
+  r.cpu_seconds = 2.5;
+  r.simulated_seconds = 10;
+  r.real_time_factor = 0.25;
+  RunHealth& h = r.health;
+  h.steps = 1000;
+  h.parts_exited = 1;
+  h.parts_fell = 2;
+  h.parts_through_fixture = 1;
+  h.coulomb_fallback_steps = 30;
+  h.solver_unconverged_steps = 4;
+  h.friction_dropped_contacts = 7;
+  h.gyroscopic_fallback_steps = 2;
+  h.max_part_speed = 3.5;
+  h.speed_bound = 100;
+  h.ignored_settings = {"solver.apgd = true (ODE ignores it)"};
+  h.local_law_feeders = 1;
+  h.local_law.contacts = 123456789012LL;
+  h.local_law.wall_contacts = 5;
+  h.local_law.cells_computed = 6;
+  h.local_law.model_runs = 7;
+  r.scene_check = {"tunnelling: step \\ 2\nsafe"};
+  r.feeder.note = "the scene has no exit plane";
+  return r;
+}
+
+std::vector<std::vector<std::string>> csvRows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::istringstream l(line);
+    std::string cell;
+    while (std::getline(l, cell, ',')) cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+TEST(SeriesCsv, OneRowPerSampleReadsBackAsTheSeries) {
+  const RunMetrics r = run();
+  const auto rows = csvRows(seriesCsv(r));
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0], (std::vector<std::string>{"time_s", "parts", "mean_velocity_mps", "ci95_mps",
+                                               "mean_height_m", "exited", "lost_fell",
+                                               "lost_through_fixture", "lost_out_of_bounds",
+                                               "lost_nonfinite", "lost_too_fast"}));
+  for (std::size_t k = 0; k < r.series.size(); ++k) {
+    const DriftSample& d = r.series[k];
+    const auto& row = rows[k + 1];
+    ASSERT_EQ(row.size(), 11u);
+    EXPECT_NEAR(std::stod(row[0]), d.time, kSixDecimals);
+    EXPECT_EQ(std::stoi(row[1]), d.parts);
+    EXPECT_NEAR(std::stod(row[2]), d.mean_velocity, kEightDigits * std::abs(d.mean_velocity));
+    EXPECT_NEAR(std::stod(row[3]), d.ci95, kEightDigits * d.ci95);
+    EXPECT_NEAR(std::stod(row[4]), d.mean_height, kEightDigits * d.mean_height);
+    const int counts[] = {d.exited,        d.fell,      d.through_fixture,
+                          d.out_of_bounds, d.nonfinite, d.too_fast};
+    for (int c = 0; c < 6; ++c) EXPECT_EQ(std::stoi(row[5 + c]), counts[c]) << "column " << 5 + c;
+  }
+}
+
+TEST(SummaryJson, ParsesToTheRunMetricsWritten) {
+  const RunMetrics r = run();
+  const std::string text = summaryJson(r);
+  EXPECT_EQ(text.find('\n'), std::string::npos) << "one line";
+  const json j = json::parse(text);
+  EXPECT_EQ(j["scene"], r.scene);
+  EXPECT_EQ(j["method"], "reference_rheonomic");
+  EXPECT_NEAR(j["time_step_s"].get<double>(), 0.01, kEightDigits * 0.01);
+  EXPECT_EQ(j["parts"], 12);
+  EXPECT_EQ(j["drift_unit"], "m/s");
+  EXPECT_NEAR(j["mean_drift"].get<double>(), r.mean_drift, kEightDigits * r.mean_drift);
+  EXPECT_NEAR(j["mean_drift_ci95"].get<double>(), r.mean_drift_ci95,
+              kEightDigits * r.mean_drift_ci95);
+  EXPECT_NEAR(j["vertical_displacement_m"].get<double>(), r.vertical_displacement,
+              kEightDigits * 4e-4);
+  EXPECT_DOUBLE_EQ(j["throughput_parts_per_s"].get<double>(), 1.5);
+  EXPECT_DOUBLE_EQ(j["simulated_seconds"].get<double>(), 10);
+  EXPECT_EQ(j["seed"].get<std::uint64_t>(), r.seed);
+  EXPECT_EQ(j["drift_models"], json(r.drift_models));
+
+  const json& h = j["health"];
+  EXPECT_EQ(h["steps"], 1000);
+  EXPECT_EQ(h["parts_removed_after_exit"], 1);
+  EXPECT_EQ(h["parts_lost"], 3);  // fell 2 + through a fixture 1
+  EXPECT_EQ(h["parts_fell"], 2);
+  EXPECT_EQ(h["parts_through_fixture"], 1);
+  EXPECT_EQ(h["coulomb_fallback_steps"], 30);
+  EXPECT_NEAR(h["coulomb_fallback_share"].get<double>(), 0.03, kSixDigits * 0.03);  // 30 / 1000
+  EXPECT_EQ(h["solver_unconverged_steps"], 4);
+  EXPECT_EQ(h["friction_dropped_contacts"], 7);
+  EXPECT_EQ(h["gyroscopic_fallback_steps"], 2);
+  EXPECT_DOUBLE_EQ(h["max_part_speed_mps"].get<double>(), 3.5);
+  EXPECT_DOUBLE_EQ(h["speed_bound_mps"].get<double>(), 100);
+  EXPECT_EQ(h["ignored_settings"], json(r.health.ignored_settings));
+  EXPECT_EQ(j["scene_check"], json(r.scene_check));  // quotes, backslash and newline escaped
+
+  EXPECT_EQ(j["feeder"]["note"], r.feeder.note);
+  EXPECT_EQ(j["feeder"]["exit_plane"], false);
+  const json& l = j["local_law"];
+  EXPECT_EQ(l["feeders"], 1);
+  EXPECT_EQ(l["contacts"].get<long long>(), 123456789012LL);
+  EXPECT_EQ(l["wall_contacts"], 5);
+  EXPECT_EQ(l["cells_computed"], 6);
+  EXPECT_EQ(l["model_runs"], 7);
+}
+
+TEST(SummaryJson, AngularRunsSayRadiansPerSecond) {
+  RunMetrics r = run();
+  r.angular = true;
+  EXPECT_EQ(json::parse(summaryJson(r))["drift_unit"], "rad/s");
+}
+
+TEST(WriteRunOutputs, WritesTheCsvAndTheJsonCompletelyAndNoTemporaryFile) {
+  const fs::path folder = fs::path(testing::TempDir()) / "rheofeed_run_outputs_test";
+  fs::remove_all(folder);
+  const RunMetrics r = run();
+  const std::vector<std::string> written = writeRunOutputs(r, folder.string(), "ode");
+  ASSERT_GE(written.size(), 2u);
+  EXPECT_EQ(written[0], (folder / "ode.csv").string());
+  EXPECT_EQ(written[1], (folder / "ode.json").string());
+  std::ifstream csv(folder / "ode.csv"), js(folder / "ode.json");
+  std::ostringstream csv_text;
+  csv_text << csv.rdbuf();
+  EXPECT_EQ(csv_text.str(), seriesCsv(r));
+  EXPECT_EQ(json::parse(js)["mean_drift"], json::parse(summaryJson(r))["mean_drift"]);
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    EXPECT_EQ(entry.path().string().find(".partial"), std::string::npos) << entry.path();
+  }
+}
+
+}  // namespace
+}  // namespace rheofeed::scene

@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: MIT
+// Test support: the scene pieces the scene, validation and view tests build again and again - a
+// box fixture whose top face sits at a given point, and the same box vibrating - so that each
+// test states only its own numbers. Header-only; needs rheofeed::scene.
+#pragma once
+
+#include <string>
+
+#include "rheofeed/scene/scene.hpp"
+
+namespace rheofeed::test {
+
+/// A static box fixture named `name` of edge lengths `size` (m), axis-aligned, whose top face
+/// is centred at `top_centre` (m, world frame): the box centre is top_centre - (0, 0, size.z / 2).
+inline scene::Fixture boxFixture(const std::string& name, const Vec3& size,
+                                 const Vec3& top_centre = {}) {
+  scene::Fixture f;
+  f.name = name;
+  scene::Fixture::Geom g;
+  g.shape.kind = scene::Shape::Kind::Box;
+  g.shape.size = size;
+  g.pose.position = top_centre - Vec3{0, 0, 0.5 * size.z};
+  f.geoms.push_back(g);
+  return f;
+}
+
+/// boxFixture vibrating in translation: displacement `amplitude` (m) along the unit `direction`
+/// (world frame) at `frequency` (Hz), sinusoidal (scene.hpp Vibration; its other settings at
+/// their defaults).
+inline scene::Fixture vibratingBox(const std::string& name, const Vec3& size,
+                                   const Vec3& top_centre, double amplitude, double frequency,
+                                   const Vec3& direction) {
+  scene::Fixture f = boxFixture(name, size, top_centre);
+  f.law.kind = scene::FeederLaw::Kind::Vibration;
+  f.law.vibration.amplitude = amplitude;
+  f.law.vibration.frequency = frequency;
+  f.law.vibration.direction = direction;
+  return f;
+}
+
+}  // namespace rheofeed::test
