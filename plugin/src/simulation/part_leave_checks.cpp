@@ -88,9 +88,13 @@ bool PartSimulation::leftFeeder(std::size_t i, const PartState& s, std::string& 
     where = out.str();
     return true;
   }
-  if (tr.stranger >= 0 && dot(s.position, up_) < lowest_bottom) {
-    out << "under it, onto fixture '" << scene_.fixtures[static_cast<std::size_t>(tr.stranger)].name
-        << "' (fixtures[" << tr.stranger << "]), at " << formatPosition(s.position);
+  if (dot(s.position, up_) < lowest_bottom) {
+    out << "under it (below the bottom of every fixture that carried it, over an edge or "
+        << "through a gap), at " << formatPosition(s.position);
+    if (tr.stranger >= 0) {
+      out << ", on fixture '" << scene_.fixtures[static_cast<std::size_t>(tr.stranger)].name
+          << "' (fixtures[" << tr.stranger << "])";
+    }
     where = out.str();
     return true;
   }

@@ -53,9 +53,10 @@ struct ContactTotals {
 ///       axes) of every geom of its carriers, each grown by kFootprintRadii bounding radii of
 ///       the part plus the geom's vibration reach (A + theta R): it is beyond the feeder's
 ///       footprint, in the air or on a catch floor, having gone over a wall, a rim or a side;
-///   (b) or a fixture that is not one of its carriers supports it while its centre is below the
-///       bottom of every carrier geom whose grown box that line meets: it fell under the feeder
-///       (through a gap) onto a floor.
+///   (b) or its centre is below the bottom of every carrier geom whose grown box that line
+///       meets: it fell under the feeder (over an edge within the boxes' corners, or through a
+///       gap), in the air or onto a floor (named when a fixture that is not one of its
+///       carriers supports it).
 /// A carrier that is a plane, or a mesh that is not loaded, has no footprint (it covers every
 /// line). The part is counted (parts_left_feeder), reported with where it crossed, and kept.
 /// Parts that never touch a feeder are not followed (a scene without feeders never counts).
