@@ -288,7 +288,7 @@ Scene everyFieldScene() {
   s.parts.push_back(nuts);
 
   s.material = {0.35, 0.2};
-  s.solver = {0.002, 77, false, 0.3, 1e-6, 1e-8, false, 3};
+  s.solver = {0.002, 77, false, std::nullopt, 0.3, 1e-6, 1e-8, false, 3};
   s.outputs.conveying_direction = {0, 1, 0};
   s.outputs.angular_drift = true;
   s.outputs.axis_origin = {-3, 0, 0};
