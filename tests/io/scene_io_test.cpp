@@ -19,6 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const fs::path kData = RHEOFEED_IO_TEST_DATA;
+constexpr double kPi = 3.14159265358979323846;
 // Rotations go through axis-angle in the file: a few ulp per matrix entry.
 constexpr double kRotationTolerance = 1e-14;
 
@@ -140,6 +141,7 @@ void expectSameScene(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.solver.time_step, b.solver.time_step);
   EXPECT_EQ(a.solver.iterations, b.solver.iterations);
   EXPECT_EQ(a.solver.ode_quickstep, b.solver.ode_quickstep);
+  EXPECT_EQ(a.solver.friction, b.solver.friction);
   EXPECT_EQ(a.solver.erp, b.solver.erp);
   EXPECT_EQ(a.solver.cfm, b.solver.cfm);
   EXPECT_EQ(a.solver.tolerance, b.solver.tolerance);
@@ -288,7 +290,8 @@ Scene everyFieldScene() {
   s.parts.push_back(nuts);
 
   s.material = {0.35, 0.2};
-  s.solver = {0.002, 77, false, std::nullopt, 0.3, 1e-6, 1e-8, false, 3};
+  s.solver = {0.002, 77, false, 0.3, 1e-6, 1e-8, false, 3};
+  s.solver.friction = FrictionModel::Pyramid;  // a Dantzig scene may ask for the pyramid
   s.outputs.conveying_direction = {0, 1, 0};
   s.outputs.angular_drift = true;
   s.outputs.axis_origin = {-3, 0, 0};

@@ -192,12 +192,6 @@ struct SolverSettings {
   double time_step = 0.01;
   int iterations = 50;        ///< ODE quickstep iterations or CCP iteration budget ([1, 1e6])
   bool ode_quickstep = true;  ///< ODE: dWorldQuickStep (true) or dWorldStep (Dantzig)
-  /// ODE's friction law (friction_model.hpp; JSON "cone" or "pyramid"). Unset: the cone where
-  /// the linked ODE has it (rheofeed's patched ODE) and ode_quickstep is true, else the pyramid
-  /// (simulation.hpp, odeFrictionModel). Asking for the cone with ode_quickstep = false is
-  /// refused by validate(), on a stock ODE by the ODE simulation. The reference engine always
-  /// solves the cone (a pyramid asked of it is an ignored setting).
-  std::optional<FrictionModel> friction;
   double erp = 0.2;           ///< ODE and reference (in [0, 1])
   double cfm = 1e-5;          ///< ODE and reference (ODE's units, finite, >= 0)
   double tolerance = 1e-6;    ///< CCP residual tolerance (finite, > 0)
@@ -223,6 +217,12 @@ struct SolverSettings {
   /// time_step. Read by the runners (the `rheofeed` command), not by makeSimulation, which
   /// always steps with time_step.
   double rheonomic_time_step = 0;
+  /// ODE's friction law (friction_model.hpp; JSON "cone" or "pyramid"). Unset: the cone where
+  /// the linked ODE has it (rheofeed's patched ODE) and ode_quickstep is true, else the pyramid
+  /// (simulation.hpp, odeFrictionModel). Asking for the cone with ode_quickstep = false is
+  /// refused by validate(), on a stock ODE by the ODE simulation. The reference engine always
+  /// solves the cone (a pyramid asked of it is an ignored setting).
+  std::optional<FrictionModel> friction;
 };
 
 /// The four methods.
