@@ -94,7 +94,7 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
     if (args.duration_given && !args.warmup_given &&
         std::string(e.what()).rfind("outputs.warmup", 0) == 0) {
       hint = "; the scene's warmup is longer than the run: give --warmup 0 (or a warmup below " +
-             number(args.duration) + " s) with a short --duration";
+             formatNumber(args.duration) + " s) with a short --duration";
     }
     throw std::invalid_argument(where + ": " + e.what() + hint);
   }
@@ -111,8 +111,8 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
       std::fprintf(stderr,
                    "rheofeed: %s: outputs.sample_interval = %s s is shorter than this run's step "
                    "h = %s s (%s): it samples once per step, every %s s\n",
-                   toString(m), number(scene.outputs.sample_interval).c_str(), number(h).c_str(),
-                   run.step_source.c_str(), number(run.scene.outputs.sample_interval).c_str());
+                   toString(m), formatNumber(scene.outputs.sample_interval).c_str(), formatNumber(h).c_str(),
+                   run.step_source.c_str(), formatNumber(run.scene.outputs.sample_interval).c_str());
     }
     try {
       run.scene.validate();

@@ -7,6 +7,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/sweep.hpp"
+#include "rheofeed/number_format.hpp"
 
 namespace rheofeed::cli {
 
@@ -22,14 +23,14 @@ void printPlan(const Spec& spec) {
   std::printf("\n");
   for (const Parameter& p : spec.parameters) {
     std::printf("  %s (%s%s): ", p.name.c_str(), p.pointer.c_str(),
-                p.scale != 1 ? (", x " + number(p.scale)).c_str() : "");
+                p.scale != 1 ? (", x " + formatNumber(p.scale)).c_str() : "");
     if (p.kind == Parameter::Kind::LatinHypercube) {
-      std::printf("Latin hypercube in [%s, %s], %d samples, seed %llu\n", number(p.from).c_str(),
-                  number(p.to).c_str(), spec.lhs_samples,
+      std::printf("Latin hypercube in [%s, %s], %d samples, seed %llu\n", formatNumber(p.from).c_str(),
+                  formatNumber(p.to).c_str(), spec.lhs_samples,
                   static_cast<unsigned long long>(spec.lhs_seed));
     } else {
       for (std::size_t k = 0; k < p.values.size(); ++k) {
-        std::printf("%s%s", k ? ", " : "", number(p.values[k]).c_str());
+        std::printf("%s%s", k ? ", " : "", formatNumber(p.values[k]).c_str());
       }
       std::printf("\n");
     }

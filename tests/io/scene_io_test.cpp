@@ -290,7 +290,15 @@ Scene everyFieldScene() {
   s.parts.push_back(nuts);
 
   s.material = {0.35, 0.2};
-  s.solver = {0.002, 77, false, 0.3, 1e-6, 1e-8, false, 3};
+  s.solver = SolverSettings{};
+  s.solver.time_step = 0.002;
+  s.solver.iterations = 77;
+  s.solver.ode_quickstep = false;
+  s.solver.erp = 0.3;
+  s.solver.cfm = 1e-6;
+  s.solver.tolerance = 1e-8;
+  s.solver.apgd = false;
+  s.solver.coulomb_iterations = 3;
   s.solver.friction = FrictionModel::Pyramid;  // a Dantzig scene may ask for the pyramid
   s.outputs.conveying_direction = {0, 1, 0};
   s.outputs.angular_drift = true;
