@@ -201,6 +201,9 @@ class Builder {
   /// it needs mu > 0, otherwise the drift is 0 and the note says so). Then the bounds box.
   StabilityCase finish() {
     Scene& s = c_.scene;
+    // A run samples at most once per step (Scene::validate refuses a shorter sample interval):
+    // the coarse-step cases sample once per step.
+    s.outputs.sample_interval = std::max(s.outputs.sample_interval, s.solver.time_step);
     for (std::size_t f = 0; f < s.fixtures.size(); ++f) {
       if (s.fixtures[f].law.kind != FeederLaw::Kind::Vibration) continue;
       try {

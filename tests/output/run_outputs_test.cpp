@@ -103,11 +103,12 @@ TEST(SeriesCsv, OneRowPerSampleReadsBackAsTheSeries) {
   EXPECT_EQ(rows[0], (std::vector<std::string>{"time_s", "parts", "mean_velocity_mps", "ci95_mps",
                                                "mean_height_m", "exited", "lost_fell",
                                                "lost_through_fixture", "lost_out_of_bounds",
-                                               "lost_nonfinite", "lost_too_fast"}));
+                                               "lost_nonfinite", "lost_too_fast",
+                                               "lost_left_feeder"}));
   for (std::size_t k = 0; k < r.series.size(); ++k) {
     const DriftSample& d = r.series[k];
     const auto& row = rows[k + 1];
-    ASSERT_EQ(row.size(), 11u);
+    ASSERT_EQ(row.size(), 12u);
     EXPECT_NEAR(std::stod(row[0]), d.time, kSixDecimals);
     EXPECT_EQ(std::stoi(row[1]), d.parts);
     EXPECT_NEAR(std::stod(row[2]), d.mean_velocity, kEightDigits * std::abs(d.mean_velocity));
