@@ -13,8 +13,8 @@
 #include <exception>
 #include <string>
 
-#include "common/study.hpp"
 #include "common/builtin_scenes.hpp"
+#include "common/study.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 #include "study/drift_models.hpp"
 

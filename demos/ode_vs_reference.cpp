@@ -53,7 +53,8 @@ std::vector<Case> cases(int pile) {
       << " m/s^2, |v| = " << a * s.duration << " m/s at t = " << s.duration << " s";
     out.push_back({s, e.str(),
                    "sliding along fdir1 = belt direction, where even ODE's friction pyramid is "
-                   "exact, so both models match the cone; the reference solves true Coulomb (the relaxed CCP, "
+                   "exact, so both models match the cone; the reference solves true Coulomb (the "
+                   "relaxed CCP, "
                    "coulomb_iterations = 0, would launch the part at u_n = mu |u_t|)"});
   }
   {

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "rheofeed/measure/calibration.hpp"
 #include "cli/run_plan.hpp"
+#include "rheofeed/measure/calibration.hpp"
 
 namespace rheofeed::cli {
 

@@ -111,8 +111,9 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
       std::fprintf(stderr,
                    "rheofeed: %s: outputs.sample_interval = %s s is shorter than this run's step "
                    "h = %s s (%s): it samples once per step, every %s s\n",
-                   toString(m), formatNumber(scene.outputs.sample_interval).c_str(), formatNumber(h).c_str(),
-                   run.step_source.c_str(), formatNumber(run.scene.outputs.sample_interval).c_str());
+                   toString(m), formatNumber(scene.outputs.sample_interval).c_str(),
+                   formatNumber(h).c_str(), run.step_source.c_str(),
+                   formatNumber(run.scene.outputs.sample_interval).c_str());
     }
     try {
       run.scene.validate();

@@ -25,8 +25,8 @@ void printPlan(const Spec& spec) {
     std::printf("  %s (%s%s): ", p.name.c_str(), p.pointer.c_str(),
                 p.scale != 1 ? (", x " + formatNumber(p.scale)).c_str() : "");
     if (p.kind == Parameter::Kind::LatinHypercube) {
-      std::printf("Latin hypercube in [%s, %s], %d samples, seed %llu\n", formatNumber(p.from).c_str(),
-                  formatNumber(p.to).c_str(), spec.lhs_samples,
+      std::printf("Latin hypercube in [%s, %s], %d samples, seed %llu\n",
+                  formatNumber(p.from).c_str(), formatNumber(p.to).c_str(), spec.lhs_samples,
                   static_cast<unsigned long long>(spec.lhs_seed));
     } else {
       for (std::size_t k = 0; k < p.values.size(); ++k) {

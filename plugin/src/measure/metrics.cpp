@@ -11,7 +11,6 @@
 #include <sstream>
 #include <stdexcept>
 
-
 namespace rheofeed::scene {
 namespace {
 
@@ -142,8 +141,11 @@ namespace {
 class RunMeter : public RunObserver {
  public:
   RunMeter(const Scene& scene, Method method, const RunSchedule& schedule)
-      : scene_(scene), out_(scene.outputs), h_(scene.solver.time_step),
-        every_(schedule.sample_every), family_(partFamilies(scene)) {
+      : scene_(scene),
+        out_(scene.outputs),
+        h_(scene.solver.time_step),
+        every_(schedule.sample_every),
+        family_(partFamilies(scene)) {
     m_.scene = scene.name;
     m_.method = method;
     m_.time_step = h_;
@@ -214,7 +216,8 @@ class RunMeter : public RunObserver {
       Track tr;
       tr.spawn = tr.previous = sim.part(i).position;
       tr.has_previous = true;
-      if (out_.angular_drift) tr.angle = angleAbout(tr.spawn, out_.axis_origin, out_.axis_direction);
+      if (out_.angular_drift)
+        tr.angle = angleAbout(tr.spawn, out_.axis_origin, out_.axis_direction);
       tr.exited = out_.exit_plane && crossed(tr.spawn);  // spawned beyond the exit: never counted
       if (tr.exited) ++m_.feeder.spawned_beyond_exit;
       tr.last = tr.spawn;

@@ -15,9 +15,9 @@ std::string seriesCsv(const RunMetrics& run) {
        "lost_through_fixture,lost_out_of_bounds,lost_nonfinite,lost_too_fast,lost_left_feeder\n";
   char line[256];
   for (const DriftSample& d : run.series) {
-    std::snprintf(line, sizeof line, "%.6f,%d,%.8g,%.8g,%.8g,%d,%d,%d,%d,%d,%d,%d\n", d.time, d.parts,
-                  d.mean_velocity, d.ci95, d.mean_height, d.exited, d.fell, d.through_fixture,
-                  d.out_of_bounds, d.nonfinite, d.too_fast, d.left_feeder);
+    std::snprintf(line, sizeof line, "%.6f,%d,%.8g,%.8g,%.8g,%d,%d,%d,%d,%d,%d,%d\n", d.time,
+                  d.parts, d.mean_velocity, d.ci95, d.mean_height, d.exited, d.fell,
+                  d.through_fixture, d.out_of_bounds, d.nonfinite, d.too_fast, d.left_feeder);
     s << line;
   }
   return s.str();

@@ -246,10 +246,9 @@ struct WorldState {
     if (it == feeder_index.end()) return Vector3d::Zero();
     const StepLaw& law = feeders[it->second].frozen;
     const Body* body = carried == kStatic ? nullptr : &bodies[static_cast<std::size_t>(carried)];
-    return detail::toEigen(contactSurfaceVelocity(law, detail::toVec3(p), detail::toVec3(n_out),
-                                                  detail::toVec3(n_out), mu,
-                                                  body ? body->efficiency : 1.0,
-                                                  body ? &body->state.position : nullptr));
+    return detail::toEigen(contactSurfaceVelocity(
+        law, detail::toVec3(p), detail::toVec3(n_out), detail::toVec3(n_out), mu,
+        body ? body->efficiency : 1.0, body ? &body->state.position : nullptr));
   }
 
   void freezeLaws(double h) {
