@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "rheofeed/collision_space.hpp"
 #include "rheofeed/contact_collider.hpp"
 #include "rheofeed/feeder_set.hpp"
 #include "rheofeed/output/output.hpp"
@@ -41,7 +42,7 @@ int run(const Options& opt) {
   dInitODE2(0);
   dWorldID world = dWorldCreate();
   dWorldSetGravity(world, 0, 0, -9.81);
-  dSpaceID space = dHashSpaceCreate(nullptr);
+  dSpaceID space = rheofeed::createCollisionSpace(nullptr);
 
   // Feed belt from x = -1 to 0, transfer belt from 0 to 2 (top surfaces at z = 0).
   dGeomID feed = dCreateBox(space, 1.0, 0.3, 0.1);

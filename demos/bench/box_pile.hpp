@@ -8,6 +8,7 @@
 
 #include <ode/ode.h>
 
+#include "rheofeed/collision_space.hpp"
 #include "rheofeed/feeder_set.hpp"
 
 namespace rheofeed::demo {
@@ -20,7 +21,7 @@ class BoxPile {
     world_ = dWorldCreate();
     dWorldSetGravity(world_, 0, 0, -9.81);
     dWorldSetQuickStepNumIterations(world_, sweeps);
-    space_ = dHashSpaceCreate(nullptr);
+    space_ = rheofeed::createCollisionSpace(nullptr);
     group_ = dJointGroupCreate(0);
     ground_ = dCreateBox(space_, 10, 10, 0.2);
     dGeomSetPosition(ground_, 0, 0, -0.1);

@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "ode_message_guard.hpp"
+#include "rheofeed/collision_space.hpp"
 #include "rheofeed/contact_collider.hpp"
 #include "rheofeed/feeder_set.hpp"
 
@@ -89,7 +90,7 @@ class OdeWorld {
     dWorldSetGravity(world, 0, 0, -kGravity);
     dWorldSetERP(world, kWorldErp);
     dWorldSetCFM(world, kWorldCfm);
-    space = dHashSpaceCreate(nullptr);
+    space = rheofeed::createCollisionSpace(nullptr);
     feeders = std::make_unique<FeederSet>(options);
     collider = std::make_unique<ContactCollider>(world, *feeders, settings);
   }

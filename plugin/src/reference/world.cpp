@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "rheofeed/collision_space.hpp"
 #include "rheofeed/reference/contact_problem.hpp"
 #include "world_internal.hpp"
 
@@ -80,7 +81,7 @@ World::World(const Settings& settings) : impl_(std::make_unique<WorldState>()) {
   // ODE's collision module must be initialised once per process before any geom is used.
   static const bool ode_initialised = (dInitODE2(0), true);
   (void)ode_initialised;
-  impl_->space = dHashSpaceCreate(nullptr);
+  impl_->space = rheofeed::createCollisionSpace(nullptr);
 }
 
 World::~World() {

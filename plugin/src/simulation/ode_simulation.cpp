@@ -16,6 +16,7 @@
 
 #include "geom_factory.hpp"
 #include "ode_vec.hpp"
+#include "rheofeed/collision_space.hpp"
 #include "rheofeed/contact_collider.hpp"
 #include "rheofeed/feeder_set.hpp"
 #include "rheofeed/reference/world.hpp"
@@ -36,7 +37,7 @@ class OdeSimulation final : public PartSimulation {
     dWorldSetQuickStepNumIterations(world_, scene.solver.iterations);
     dWorldSetContactMaxCorrectingVel(world_, scene.solver.max_correcting_velocity);
     dWorldSetContactSurfaceLayer(world_, scene.solver.surface_layer);
-    space_ = dHashSpaceCreate(nullptr);
+    space_ = rheofeed::createCollisionSpace(nullptr);
     const FrictionModel friction = odeFrictionModel(scene.solver);
     health_.friction_model = toString(friction);
     FeederSet::Options options;

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: MIT
+/// @file collision_space.hpp
+/// A broad-phase collision space that pairs every overlapping pair of geoms.
+///
+/// Stock ODE's hash space (dHashSpaceCreate, ODE 0.16.2 and earlier) misses pairs: it hashes a
+/// column of cells from the slot of its lowest cell stepped by one, in unsigned arithmetic that
+/// wraps, so a geom whose bounding box spans the plane z = 0 in the cell x = y = 0 of its level
+/// (cell size 2^level m; a 0.5-1 m trough wall standing on a floor whose top is z = 0, at x, y in
+/// [0, 1) m) is never paired with the small geoms in the cells above z = 0. Parts then pass
+/// through that fixture as if it were absent (rheofeed's main demo at 1000 parts lost 306 of them
+/// through one side wall, and none through the mirror-image wall). rheofeed's patched ODE fixes
+/// it (patches/0004-hash-space-cell-slots, dCheckConfiguration("ODE_EXT_hash_space_cells")).
+///
+/// createCollisionSpace gives the hash space where the linked ODE has the fix, and ODE's
+/// sweep-and-prune space (dSweepAndPruneSpaceCreate, all three axes; exact, O(n log n)) on a
+/// stock ODE. Applications that build their own space on a stock ODE should do the same, or
+/// use dSimpleSpace for small scenes.
+#pragma once
+
+#include <ode/ode.h>
+
+namespace rheofeed {
+
+/// True when the linked ODE's hash space has rheofeed's cell-slot fix (patches/0004). Header
+/// only (the reference world uses it without the plugin library); ODE must be initialised.
+inline bool odeHashSpaceIsSound() {
+  static const bool sound = dCheckConfiguration("ODE_EXT_hash_space_cells") != 0;
+  return sound;
+}
+
+/// A new top-level (parent null) or child space that pairs every overlapping pair of geoms:
+/// dHashSpaceCreate(parent) when odeHashSpaceIsSound(), else
+/// dSweepAndPruneSpaceCreate(parent, dSAP_AXES_XYZ). Destroy it with dSpaceDestroy.
+inline dSpaceID createCollisionSpace(dSpaceID parent) {
+  if (odeHashSpaceIsSound()) return dHashSpaceCreate(parent);
+  return dSweepAndPruneSpaceCreate(parent, dSAP_AXES_XYZ);
+}
+
+}  // namespace rheofeed
