@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "rheofeed/contact_collider.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -18,6 +20,11 @@ ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders, const Setti
                                 std::to_string(settings.max_contacts_per_pair) +
                                 " must be in 1..65535");
   }
+  if (!(settings.speculative_fraction > 0) || !std::isfinite(settings.speculative_fraction)) {
+    throw std::invalid_argument("rheofeed::ContactCollider: Settings::speculative_fraction = " +
+                                std::to_string(settings.speculative_fraction) +
+                                " must be finite and > 0");
+  }
   requireFrictionModel(settings.friction, "rheofeed::ContactCollider: Settings::friction");
   settings_.default_surface.mode =
       withFrictionModel(settings.default_surface.mode, settings.friction);
@@ -26,6 +33,8 @@ ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders, const Setti
 }
 
 ContactCollider::~ContactCollider() {
+  if (ray_) dGeomDestroy(ray_);
+  if (swept_box_) dGeomDestroy(swept_box_);
   dJointGroupDestroy(group_);
 }
 
@@ -36,7 +45,9 @@ void ContactCollider::setSurfaceCallback(SurfaceCallback callback) {
 void ContactCollider::clearJoints() {
   dJointGroupEmpty(group_);
   joints_.clear();
+  paired_.clear();
   feedback_used_ = 0;
+  speculative_count_ = 0;
 }
 
 void ContactCollider::rethrowPendingError() {
@@ -51,6 +62,13 @@ void ContactCollider::collide(dSpaceID space, double time, double step) {
   feeders_.beginStep(time, step);  // first: a refused time or step leaves everything as it was
   clearJoints();
   collideWithin(space);
+  if (settings_.speculative && step > 0 && !error_) {
+    try {
+      sweepFastBodies(space, step);
+    } catch (...) {
+      error_ = std::current_exception();
+    }
+  }
   if (error_) {
     // The pass stopped at the first exception: drop its partial joints and records, then
     // throw it here, outside ODE.
@@ -97,8 +115,21 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
   dContact* contacts = buffer_.data();
   int n = dCollide(o1, o2, settings_.max_contacts_per_pair, &contacts[0].geom, sizeof(dContact));
   if (n <= 0) return;
+  if (settings_.speculative) paired_.emplace_back(o1 < o2 ? o1 : o2, o1 < o2 ? o2 : o1);
+  addContacts(o1, o2, contacts, n, nullptr);
+}
+
+void ContactCollider::addContacts(dGeomID o1, dGeomID o2, dContact* contacts, int n,
+                                  const double* gap_speed) {
   for (int i = 0; i < n; ++i) contacts[i].surface = settings_.default_surface;
   if (surface_ && !surface_(o1, o2, contacts, n)) return;
+  if (gap_speed) {
+    for (int i = 0; i < n; ++i) {
+      contacts[i].surface.mode |= dContactMotionN;
+      contacts[i].surface.motionN = -gap_speed[i];
+    }
+    speculative_count_ += n;
+  }
   if (!odeHasFrictionCone()) {
     for (int i = 0; i < n; ++i) {
       if (contacts[i].surface.mode & kContactFrictionCone) {
@@ -147,6 +178,174 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
       r.joint = joint;
       r.feedback = fb;
     }
+  }
+}
+
+namespace {
+
+// The smallest half extent (m) of a geom, and its leading points: where a ray along the motion
+// starts (world frame). Boxes: the 8 corners; spheres: the point ahead; capsules: the point
+// ahead of each cap; anything else: the corners of its axis-aligned bounding box.
+double smallestHalfExtent(dGeomID g) {
+  switch (dGeomGetClass(g)) {
+    case dBoxClass: {
+      dVector3 l;
+      dGeomBoxGetLengths(g, l);
+      return 0.5 * std::min({l[0], l[1], l[2]});
+    }
+    case dSphereClass:
+      return dGeomSphereGetRadius(g);
+    case dCapsuleClass: {
+      dReal r, l;
+      dGeomCapsuleGetParams(g, &r, &l);
+      return r;
+    }
+    default: {
+      dReal b[6];
+      dGeomGetAABB(g, b);
+      return 0.5 * std::min({b[1] - b[0], b[3] - b[2], b[5] - b[4]});
+    }
+  }
+}
+
+int leadingPoints(dGeomID g, const dReal dir[3], dReal out[8][3]) {
+  const dReal* c = dGeomGetPosition(g);
+  const dReal* r = dGeomGetRotation(g);  // row-major 3x4
+  auto local = [&](double x, double y, double z, dReal p[3]) {
+    for (int k = 0; k < 3; ++k) p[k] = c[k] + r[4 * k] * x + r[4 * k + 1] * y + r[4 * k + 2] * z;
+  };
+  switch (dGeomGetClass(g)) {
+    case dBoxClass: {
+      dVector3 l;
+      dGeomBoxGetLengths(g, l);
+      int n = 0;
+      for (int i = 0; i < 8; ++i) {
+        local((i & 1 ? 0.5 : -0.5) * l[0], (i & 2 ? 0.5 : -0.5) * l[1],
+              (i & 4 ? 0.5 : -0.5) * l[2], out[n++]);
+      }
+      return n;
+    }
+    case dSphereClass: {
+      const dReal rad = dGeomSphereGetRadius(g);
+      for (int k = 0; k < 3; ++k) out[0][k] = c[k] + rad * dir[k];
+      return 1;
+    }
+    case dCapsuleClass: {
+      dReal rad, len;
+      dGeomCapsuleGetParams(g, &rad, &len);
+      for (int e = 0; e < 2; ++e) {
+        local(0, 0, (e ? 0.5 : -0.5) * len, out[e]);
+        for (int k = 0; k < 3; ++k) out[e][k] += rad * dir[k];
+      }
+      return 2;
+    }
+    default: {
+      dReal b[6];
+      dGeomGetAABB(g, b);
+      for (int i = 0; i < 8; ++i) {
+        out[i][0] = b[i & 1 ? 1 : 0];
+        out[i][1] = b[i & 2 ? 3 : 2];
+        out[i][2] = b[i & 4 ? 5 : 4];
+      }
+      return 8;
+    }
+  }
+}
+
+}  // namespace
+
+void ContactCollider::sweepFastBodies(dSpaceID space, double step) {
+  std::sort(paired_.begin(), paired_.end());
+  const int count = dSpaceGetNumGeoms(space);
+  std::vector<dGeomID> geoms;
+  geoms.reserve(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) geoms.push_back(dSpaceGetGeom(space, i));
+  for (dGeomID g : geoms) {
+    if (dGeomIsSpace(g)) {
+      sweepFastBodies(reinterpret_cast<dSpaceID>(g), step);
+    } else {
+      sweepGeom(g, space, step);
+    }
+  }
+}
+
+void ContactCollider::candidateCallback(void* data, dGeomID o1, dGeomID o2) {
+  auto* self = static_cast<ContactCollider*>(data);
+  dGeomID other = o1 == self->swept_box_ ? o2 : o1;
+  if (dGeomIsSpace(other)) {
+    dSpaceCollide2(self->swept_box_, other, data, &ContactCollider::candidateCallback);
+    return;
+  }
+  self->candidates_.push_back(other);
+}
+
+void ContactCollider::sweepGeom(dGeomID geom, dSpaceID root, double step) {
+  dBodyID body = dGeomGetBody(geom);
+  if (!body || !dBodyIsEnabled(body) || dBodyIsKinematic(body)) return;
+  const dReal* v = dBodyGetLinearVel(body);
+  dVector3 end_v = {v[0], v[1], v[2], 0};
+  if (dBodyGetGravityMode(body)) {
+    dVector3 g;
+    dWorldGetGravity(world_, g);
+    for (int k = 0; k < 3; ++k) end_v[k] += g[k] * step;
+  }
+  const double speed = std::sqrt(end_v[0] * end_v[0] + end_v[1] * end_v[1] + end_v[2] * end_v[2]);
+  const double travel = speed * step;
+  if (!(travel > settings_.speculative_fraction * smallestHalfExtent(geom))) return;
+  const dReal dir[3] = {end_v[0] / speed, end_v[1] / speed, end_v[2] / speed};
+
+  // Candidates: the geoms whose boxes meet the swept box (the geom's box and its box moved by
+  // the travel), but not the geom's own body and not pairs the regular pass already made.
+  dReal b[6];
+  dGeomGetAABB(geom, b);
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::min(b[2 * k], b[2 * k] + dir[k] * travel);
+    hi[k] = std::max(b[2 * k + 1], b[2 * k + 1] + dir[k] * travel);
+  }
+  if (!swept_box_) swept_box_ = dCreateBox(nullptr, 1, 1, 1);
+  dGeomBoxSetLengths(swept_box_, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  dGeomSetPosition(swept_box_, 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]));
+  candidates_.clear();
+  dSpaceCollide2(swept_box_, reinterpret_cast<dGeomID>(root), this,
+                 &ContactCollider::candidateCallback);
+  if (candidates_.empty()) return;
+
+  dReal points[8][3];
+  const int np = leadingPoints(geom, dir, points);
+  if (!ray_) {
+    ray_ = dCreateRay(nullptr, travel);
+    dGeomRaySetClosestHit(ray_, 1);
+  }
+  dGeomRaySetLength(ray_, travel);
+  std::vector<dContact>& contacts = buffer_;
+  double gap_speed[8];
+  for (dGeomID other : candidates_) {
+    if (other == geom || dGeomGetBody(other) == body) continue;
+    const auto key = std::make_pair(geom < other ? geom : other, geom < other ? other : geom);
+    if (std::binary_search(paired_.begin(), paired_.end(), key)) continue;
+    int n = 0;
+    for (int i = 0; i < np && n < static_cast<int>(contacts.size()) && n < 8; ++i) {
+      dGeomRaySet(ray_, points[i][0], points[i][1], points[i][2], dir[0], dir[1], dir[2]);
+      dContactGeom hit;
+      if (dCollide(ray_, other, 1, &hit, sizeof hit) < 1) continue;
+      double along = hit.normal[0] * dir[0] + hit.normal[1] * dir[1] + hit.normal[2] * dir[2];
+      const double sign = along > 0 ? -1.0 : 1.0;  // the normal out of `other`, against the motion
+      along = std::fabs(along);
+      if (!(along > 1e-6)) continue;                // grazing: the motion does not close it
+      dContactGeom& c = contacts[static_cast<std::size_t>(n)].geom;
+      for (int k = 0; k < 3; ++k) {
+        c.pos[k] = hit.pos[k];
+        c.normal[k] = sign * hit.normal[k];  // into g1 = the swept geom
+      }
+      c.depth = 0;
+      c.g1 = geom;
+      c.g2 = other;
+      c.side1 = c.side2 = -1;
+      gap_speed[n] = hit.depth * along / step;  // the gap along the normal, per step
+      ++n;
+    }
+    if (n > 0) addContacts(geom, other, contacts.data(), n, gap_speed);
   }
 }
 

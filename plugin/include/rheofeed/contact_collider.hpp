@@ -19,6 +19,23 @@
 /// `ContactCollider::nearCallback` to it (after `beginStep(time, h)` and `clearJoints()`), and
 /// call `rethrowPendingError()` after dSpaceCollide returns.
 ///
+/// ## Speculative contacts
+/// ODE makes contacts only where geoms already overlap, so a part that moves more than its own
+/// thickness in a step (a box falling from a hopper at h = 0.01 s) can land with its centre
+/// inside a fixture, or pass through a thin one. With Settings::speculative, collide() sweeps
+/// each fast body (Settings::speculative_fraction) along its velocity at the end of the step:
+/// rays from its leading points (a box's 8 corners; a sphere's or capsule's point ahead; for
+/// other shapes the corners of the geom's bounding box, which may stop a part up to that box's
+/// slack short of the surface for one step) over the travel |v + g h| h, against every geom of
+/// the space that the regular pass did not already pair with it. A ray that hits at distance t
+/// gives a contact at the hit point, normal n the hit surface's (out of the obstacle, against
+/// the motion), depth 0, and the gap d = t |v^ . n| as a velocity bound: the surface mode gains
+/// dContactMotionN with motionN = -d / h, so the normal row lets the bodies close at most the
+/// gap within the step (J v >= -d / h; stock ODE, no patch) and pushes only if they would
+/// overlap at its end. Friction on such a contact is bounded by its normal impulse, zero unless
+/// it closes. The contacts go through the SurfaceCallback and the FeederSet like any other
+/// (the motionN is set after the callback) and are counted (speculativeContactCount).
+///
 /// ## Friction model
 /// Settings::friction sets dContactFrictionCone (cone) or clears it (pyramid) on every contact
 /// before the SurfaceCallback, which may choose per contact. A contact that asks for the cone
@@ -40,6 +57,7 @@
 #include <deque>
 #include <exception>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "rheofeed/feeder_set.hpp"
@@ -73,6 +91,15 @@ class ContactCollider {
     /// kContactFrictionCone); feeder contacts then get the FeederSet's friction model
     /// (FeederSet::frictionModel). Cone needs the patched ODE and dWorldQuickStep.
     FrictionModel friction = FrictionModel::Pyramid;
+    /// Speculative contacts (file comment): collide() also sweeps every body whose travel in
+    /// the step, |v + g h| h (m; v its linear velocity, g the world's gravity when the body
+    /// feels it), exceeds `speculative_fraction` times its geom's smallest half extent, and gives
+    /// it a contact with each geom its leading points would reach within the step. Off by default.
+    bool speculative = false;
+    /// Travel per step, as a fraction of a geom's smallest half extent, above which its body is
+    /// swept (finite, > 0); 0.25 catches a part well before it can pass through anything as
+    /// thick as itself.
+    double speculative_fraction = 0.25;
   };
 
   /// `world` receives the joints; `feeders` must outlive the collider. Throws
@@ -118,12 +145,21 @@ class ContactCollider {
   };
   /// Contact joints created since the last clearJoints.
   int contactCount() const { return static_cast<int>(joints_.size()); }
+  /// Of those, the speculative ones (Settings::speculative): contacts across a gap.
+  int speculativeContactCount() const { return speculative_count_; }
   const std::vector<Joint>& joints() const { return joints_; }
   dJointGroupID jointGroup() const { return group_; }
 
  private:
   void handlePair(dGeomID o1, dGeomID o2);
+  // Surface callback, cone check, FeederSet and joints for contacts[0..n) of the pair (o1, o2);
+  // `gap_speed` (m/s, one per contact) non-null marks speculative contacts (motionN = -gap/h).
+  void addContacts(dGeomID o1, dGeomID o2, dContact* contacts, int n, const double* gap_speed);
   void collideWithin(dSpaceID space);
+  // The speculative pass over `space` (and its sub-spaces) for a step of `step` s.
+  void sweepFastBodies(dSpaceID space, double step);
+  void sweepGeom(dGeomID geom, dSpaceID root, double step);
+  static void candidateCallback(void* data, dGeomID o1, dGeomID o2);
 
   dWorldID world_;
   FeederSet& feeders_;
@@ -135,6 +171,13 @@ class ContactCollider {
   std::size_t feedback_used_ = 0;
   std::vector<Joint> joints_;
   std::exception_ptr error_;  // first exception caught in the near callback, not yet rethrown
+  // Speculative pass: the regular pass's pairs, the swept geom's candidates, the ray and the
+  // swept-volume box (created on first use), and the count of speculative contacts.
+  std::vector<std::pair<dGeomID, dGeomID>> paired_;
+  std::vector<dGeomID> candidates_;
+  dGeomID sweeper_ = nullptr;
+  dGeomID ray_ = nullptr, swept_box_ = nullptr;
+  int speculative_count_ = 0;
 };
 
 }  // namespace rheofeed

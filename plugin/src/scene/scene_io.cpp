@@ -586,6 +586,8 @@ Scene readScene(const json& root) {
     m.opt("coulomb_iterations", x.coulomb_iterations, 0);
     m.opt("max_correcting_velocity", x.max_correcting_velocity, Range::Positive);
     m.opt("surface_layer", x.surface_layer, Range::NonNegative);
+    bool speculative = true;
+    if (m.opt("speculative_contacts", speculative)) x.speculative_contacts = speculative;
     m.finish();
   }
   o.opt("duration", s.duration, Range::Positive);

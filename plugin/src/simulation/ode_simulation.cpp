@@ -75,6 +75,7 @@ class OdeSimulation final : public PartSimulation {
     ContactCollider::Settings cs;
     cs.feedback = true;
     cs.friction = friction;
+    cs.speculative = scene.solver.speculative_contacts.value_or(true);
     collider_ = std::make_unique<ContactCollider>(world_, *feeders_, cs);
     const double mu = scene.material.mu, bounce = scene.material.restitution;
     const int mode =
@@ -106,6 +107,7 @@ class OdeSimulation final : public PartSimulation {
     const unsigned long outside = dRandGetSeed();  // the application's generator state
     dRandSetSeed(random_state_);
     collider_->collide(space_, t, h);  // laws frozen on [t, t + h] (secant surface velocity)
+    health_.speculative_contacts += collider_->speculativeContactCount();
     if (scene_.solver.ode_quickstep) {
       dWorldQuickStep(world_, h);
     } else {

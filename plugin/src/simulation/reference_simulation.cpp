@@ -173,6 +173,11 @@ class ReferenceSimulation final : public PartSimulation {
       ignoreSetting(
           "solver.friction = pyramid: ignored by the reference solver (it solves the cone)");
     }
+    if (scene_.solver.speculative_contacts.value_or(false)) {
+      ignoreSetting(
+          "solver.speculative_contacts = true: ignored by the reference solver (it makes "
+          "contacts only where geoms overlap)");
+    }
     if (!scene_.solver.ode_quickstep) {
       ignoreSetting(
           "solver.ode_quickstep = false: ignored by the reference solver (ODE's stepper choice)");

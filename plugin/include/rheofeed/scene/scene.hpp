@@ -223,6 +223,13 @@ struct SolverSettings {
   /// refused by validate(), on a stock ODE by the ODE simulation. The reference engine always
   /// solves the cone (a pyramid asked of it is an ignored setting).
   std::optional<FrictionModel> friction;
+  /// ODE runs: speculative contacts (contact_collider.hpp, ContactCollider::Settings::
+  /// speculative): a part that would move more than a quarter of its smallest half extent in a
+  /// step gets contacts across the gap to whatever its leading points reach within the step,
+  /// so that it lands on a fixture or a part instead of sinking into it or passing through.
+  /// Unset: on (JSON true or false sets it). The reference engine makes contacts only where
+  /// geoms overlap; a scene that sets it true says so there (an ignored setting).
+  std::optional<bool> speculative_contacts;
 };
 
 /// The four methods.

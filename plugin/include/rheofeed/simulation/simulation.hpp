@@ -138,6 +138,10 @@ struct RunHealth {
   /// The friction law the engine solved ("cone" or "pyramid"; odeFrictionModel for ODE, the
   /// reference engine always "cone"). Recorded in the run JSON.
   std::string friction_model;
+  /// ODE runs with speculative contacts (SolverSettings::speculative_contacts): contacts made
+  /// across a gap over the run (summed over steps; 0 when off and for the reference engine).
+  /// Informative, not a loss.
+  long speculative_contacts = 0;
   /// Parts lost in any way but the exit: fell + through_fixture + left_feeder + out_of_bounds +
   /// nonfinite + too_fast, plus those inside a fixture now.
   int partsLost() const {
