@@ -5,6 +5,8 @@
 #include <string>
 #include <utility>
 
+#include "stage_clock.hpp"
+
 namespace rheofeed {
 
 ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders)
@@ -97,6 +99,7 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
   dContact* contacts = buffer_.data();
   int n = dCollide(o1, o2, settings_.max_contacts_per_pair, &contacts[0].geom, sizeof(dContact));
   if (n <= 0) return;
+  const StageClock creation(contact_seconds_);  // contact creation (setContactTimer)
   for (int i = 0; i < n; ++i) contacts[i].surface = settings_.default_surface;
   if (surface_ && !surface_(o1, o2, contacts, n)) return;
   if (!odeHasFrictionCone()) {

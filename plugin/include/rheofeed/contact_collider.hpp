@@ -121,6 +121,13 @@ class ContactCollider {
   const std::vector<Joint>& joints() const { return joints_; }
   dJointGroupID jointGroup() const { return group_; }
 
+  /// Stage timing (the simulation's StageTimes, rheofeed/simulation/simulation.hpp): every later
+  /// pass adds to `*seconds` the wall-clock time (s) spent on the pairs dCollide found touching
+  /// after dCollide returned - the SurfaceCallback, FeederSet::driveContacts and the creation
+  /// and attachment of the joints. nullptr (the default) switches it off; no clock is read then.
+  /// `seconds` must outlive the passes that use it.
+  void setContactTimer(double* seconds) { contact_seconds_ = seconds; }
+
  private:
   void handlePair(dGeomID o1, dGeomID o2);
   void collideWithin(dSpaceID space);
@@ -135,6 +142,7 @@ class ContactCollider {
   std::size_t feedback_used_ = 0;
   std::vector<Joint> joints_;
   std::exception_ptr error_;  // first exception caught in the near callback, not yet rethrown
+  double* contact_seconds_ = nullptr;  // setContactTimer
 };
 
 }  // namespace rheofeed
