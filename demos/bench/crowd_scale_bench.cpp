@@ -151,10 +151,12 @@ Scene bowlWithNuts(int parts, const Options& o) {
 }
 
 // The scene at the benchmark's step and duration (the library's step rule with --dt as the
-// override), its warm-up shortened to half the duration where longer (--quick).
+// override), its warm-up and sample interval shortened to half the duration where longer
+// (--quick).
 Scene prepared(Scene s, const Options& o) {
   s.duration = o.duration;
   s.outputs.warmup = std::min(s.outputs.warmup, 0.5 * o.duration);
+  s.outputs.sample_interval = std::min(s.outputs.sample_interval, 0.5 * o.duration);
   StepOverrides overrides;
   overrides.every_run = o.dt;
   overrides.every_run_name = "--dt";
@@ -183,7 +185,8 @@ const char* kCsvHeader =
     "cpu_per_wall,real_time_factor,cpu_ms_per_step,wall_ms_per_step,collision_ms_per_step,"
     "contacts_ms_per_step,solve_ms_per_step,scene_layer_ms_per_step,checks_ms_per_step,"
     "contacts_per_part,rows_per_part,lost,lost_through_fixture,lost_fell,lost_inside_fixture,"
-    "lost_left_feeder,lost_other,sunk,exited,scene_check_warnings,cpu_slope_from_previous\n";
+    "lost_left_feeder,lost_other,sunk,exited,local_law_cells,local_law_model_runs,"
+    "scene_check_warnings,cpu_slope_from_previous\n";
 
 std::string csvRow(const Row& r, const Row* previous) {
   const RunHealth& h = r.metrics.health;
@@ -201,7 +204,8 @@ std::string csvRow(const Row& r, const Row* previous) {
        << h.partsLost() << ',' << h.parts_through_fixture << ',' << h.parts_fell << ','
        << h.parts_inside_fixture << ',' << h.parts_left_feeder << ','
        << h.parts_out_of_bounds + h.parts_nonfinite + h.parts_too_fast << ',' << h.parts_sunk << ','
-       << h.parts_exited << ',' << r.check_warnings << ',';
+       << h.parts_exited << ',' << h.local_law.cells_computed << ',' << h.local_law.model_runs
+       << ',' << r.check_warnings << ',';
   if (previous) {
     line << formatNumber(slope(previous->parts, previous->cpuPerStep(), r.parts, r.cpuPerStep()),
                          3);
@@ -219,6 +223,13 @@ std::vector<const Row*> rowsOf(const std::vector<Row>& rows, const std::string& 
   return out;
 }
 
+// The span of the overall slope: the second smallest count to the largest (the smallest run is
+// dominated by fixed costs); the only two rows when there are two.
+std::pair<const Row*, const Row*> overallSpan(const std::vector<const Row*>& rows) {
+  if (rows.size() < 2) return {nullptr, nullptr};
+  return {rows[rows.size() >= 3 ? 1 : 0], rows.back()};
+}
+
 std::string markdownTables(const std::vector<const Row*>& rows, const std::string& title) {
   if (rows.empty()) return "";
   std::ostringstream md;
@@ -226,7 +237,8 @@ std::string markdownTables(const std::vector<const Row*>& rows, const std::strin
   md << "## " << title << "\n\n"
      << "| parts | CPU (s) | real-time factor | CPU ms/step | collision | contacts + plugin | "
         "solve | scene layer | contacts/part | rows/part | lost (through, fell, inside) | "
-        "sunk | slope |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "sunk | point-mass runs | slope |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "---|\n";
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const Row& r = *rows[k];
     const RunHealth& h = r.metrics.health;
@@ -236,17 +248,17 @@ std::string markdownTables(const std::vector<const Row*>& rows, const std::strin
        << ms(cpuPerStep(r, kStages[2])) << " | " << ms(cpuPerStep(r, kStages[3])) << " | "
        << formatNumber(r.contactsPerPart(), 3) << " | " << formatNumber(r.rowsPerPart(), 3) << " | "
        << h.partsLost() << " (" << h.parts_through_fixture << ", " << h.parts_fell << ", "
-       << h.parts_inside_fixture << ") | " << h.parts_sunk << " | "
+       << h.parts_inside_fixture << ") | " << h.parts_sunk << " | " << h.local_law.model_runs
+       << " | "
        << (k ? formatNumber(
                    slope(rows[k - 1]->parts, rows[k - 1]->cpuPerStep(), r.parts, r.cpuPerStep()), 3)
              : std::string("-"))
        << " |\n";
   }
   md << "\n";
-  // The overall span: second smallest count to the largest (the smallest is fixed costs).
-  if (rows.size() >= 2) {
-    const Row& a = *rows[rows.size() >= 3 ? 1 : 0];
-    const Row& b = *rows.back();
+  if (const auto [first, last] = overallSpan(rows); first && last) {
+    const Row& a = *first;
+    const Row& b = *last;
     md << "Overall " << a.parts << " -> " << b.parts << " parts: CPU per step grows as N^"
        << formatNumber(slope(a.parts, a.cpuPerStep(), b.parts, b.cpuPerStep()), 3)
        << " (wall-clock per step N^"
@@ -285,10 +297,51 @@ std::string markdownTables(const std::vector<const Row*>& rows, const std::strin
   return md.str();
 }
 
-std::string plotScript(const std::vector<std::string>& scenes, double dt) {
+// Issue 17's goals for the trough, against the rows that measure them (the counts asked for):
+// cost growth no faster than N^1.1 from 250 to 2000 parts, a real-time factor of at most 0.1 at
+// 500 parts and 0.5 at 2000, no part lost through a fixture and none sunk, at every count.
+std::string troughGoals(const std::vector<const Row*>& rows) {
+  const auto at = [&](int parts) -> const Row* {
+    for (const Row* r : rows) {
+      if (r->parts == parts) return r;
+    }
+    return nullptr;
+  };
+  std::ostringstream md;
+  const char* bullet = "- ";
+  if (const Row* a = at(250), *b = at(2000); a && b) {
+    const double s = slope(a->parts, a->cpuPerStep(), b->parts, b->cpuPerStep());
+    md << bullet << "cost per step N^1.1 or slower from 250 to 2000 parts: N^" << formatNumber(s, 3)
+       << (s <= 1.1 ? " (met)"
+                    : " (missed: " +
+                          formatNumber(b->cpuPerStep() / a->cpuPerStep() /
+                                           std::pow(double(b->parts) / a->parts, 1.1),
+                                       3) +
+                          " x the cost per step at 2000 that N^1.1 allows)")
+       << "\n";
+  }
+  for (const auto& [parts, goal] : {std::pair{500, 0.1}, std::pair{2000, 0.5}}) {
+    if (const Row* r = at(parts)) {
+      const double rtf = r->metrics.real_time_factor;
+      md << bullet << "real-time factor at " << parts << " parts <= " << formatNumber(goal) << ": "
+         << formatNumber(rtf, 3)
+         << (rtf <= goal ? " (met)" : " (missed: " + formatNumber(rtf / goal, 3) + " x)") << "\n";
+    }
+  }
+  int lossy = 0;
+  for (const Row* r : rows) {
+    lossy += r->metrics.health.parts_through_fixture > 0 || r->metrics.health.parts_sunk > 0;
+  }
+  md << bullet << "no part through a fixture and none sunk: " << (lossy ? "missed" : "met") << " ("
+     << lossy << " of " << rows.size() << " part counts lose or sink parts; table above)\n";
+  return "## Issue 17's goals (trough, ODE + plugin)\n\n" + md.str() + "\n";
+}
+
+std::string plotScript(const std::vector<std::pair<std::string, std::vector<const Row*>>>& scenes,
+                       double dt) {
   std::ostringstream gp;
-  gp << "set datafile separator ','\nset logscale xy\nset grid\nset key top left\n"
-     << "set xlabel 'parts'\nset ylabel 'CPU time per step (ms)'\n"
+  gp << "set datafile separator ','\nset logscale xy\nset autoscale xfix\nset grid\n"
+     << "set key top left\nset xlabel 'parts'\nset ylabel 'CPU time per step (ms)'\n"
      << "set multiplot layout 1," << scenes.size()
      << " title 'ODE + plugin, h = " << formatNumber(dt)
      << " s: time per step by stage (log-log)'\n";
@@ -299,7 +352,7 @@ std::string plotScript(const std::vector<std::string>& scenes, double dt) {
                                                 {15, "contacts + plugin"},
                                                 {16, "solve"},
                                                 {17, "scene layer"}};
-  for (const std::string& scene : scenes) {
+  for (const auto& [scene, rows] : scenes) {
     gp << "set title '" << scene << "'\nplot ";
     const char* comma = "";
     for (const auto& [column, title] : series) {
@@ -307,6 +360,13 @@ std::string plotScript(const std::vector<std::string>& scenes, double dt) {
       gp << comma << "$data using (strcol(1) eq '" << scene << "' ? $2 : 1/0):((" << y << " > 0) ? "
          << y << " : 1/0) with linespoints lw 2 pt 7 title '" << title << "'";
       comma = ", ";
+    }
+    // Linear cost from the start of the overall span: what the measured line is read against.
+    const auto [a, b] = overallSpan(rows);
+    if (a && b) {
+      gp << ", (x >= " << a->parts << " && x <= " << b->parts << ") ? "
+         << formatNumber(1e3 * a->cpuPerStep()) << " * x / " << a->parts
+         << " : 1/0 with lines dt 2 lw 2 lc rgb 'gray40' title 'N^1 from " << a->parts << "'";
     }
     gp << "\n";
   }
@@ -321,7 +381,7 @@ std::string commandLine(const Options& o) {
     c << " --quick";
   } else {
     auto list = [](const std::vector<int>& v) {
-      std::string s;
+      std::string s = v.empty() ? "0" : "";  // a lone 0: no run of the scene
       for (std::size_t k = 0; k < v.size(); ++k) s += (k ? "," : "") + std::to_string(v[k]);
       return s;
     };
@@ -347,9 +407,15 @@ int run(const Options& o) {
   // Every scene is built (and its file read) before the first run: a bad input stops here.
   std::vector<Scene> scenes;
   for (const Job& j : jobs) {
-    scenes.push_back(
-        prepared(j.scene == "trough" ? hopperTrough(j.parts) : bowlWithNuts(j.parts, o), o));
-    scenes.back().validate();
+    try {
+      scenes.push_back(
+          prepared(j.scene == "trough" ? hopperTrough(j.parts) : bowlWithNuts(j.parts, o), o));
+      scenes.back().validate();
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(j.scene + " with " + std::to_string(j.parts) +
+                                  " parts, --duration " + formatNumber(o.duration) + " s, --dt " +
+                                  formatNumber(o.dt) + " s: " + e.what());
+    }
   }
   std::vector<Row> rows;
   for (std::size_t k = 0; k < jobs.size(); ++k) {
@@ -391,6 +457,7 @@ int run(const Options& o) {
      << "crowd_scale_bench`). Data: crowd_scale.csv; plot: crowd_scale.png.\n\n";
   md << markdownTables(rowsOf(rows, "trough"), "Hopper-fed trough (linear_trough)");
   md << markdownTables(rowsOf(rows, "bowl"), "Bowl feeder (bowl_feeder)");
+  if (!rowsOf(rows, "trough").empty()) md << troughGoals(rowsOf(rows, "trough"));
   md << "Columns: CPU (s) and real-time factor (CPU / simulated time) of the whole run; CPU "
         "ms/step and the stages per step, each stage its share of the run loop's wall-clock "
         "time times the CPU time per step (they add up to the CPU column; crowd_scale.csv has "
@@ -408,9 +475,10 @@ int run(const Options& o) {
   const fs::path out(o.out);
   writeFileAtomically(out / "crowd_scale.csv", csv.str());
   writeFileAtomically(out / "crowd_scale.md", md.str());
-  std::vector<std::string> plotted;
-  if (!rowsOf(rows, "trough").empty()) plotted.push_back("trough");
-  if (!rowsOf(rows, "bowl").empty()) plotted.push_back("bowl");
+  std::vector<std::pair<std::string, std::vector<const Row*>>> plotted;
+  for (const char* scene : {"trough", "bowl"}) {
+    if (!rowsOf(rows, scene).empty()) plotted.emplace_back(scene, rowsOf(rows, scene));
+  }
   const bool plot =
       plotPng(plotScript(plotted, o.dt), {{"data", csv.str()}}, (out / "crowd_scale.png").string());
   std::fprintf(stderr, "crowd_scale: wrote %s/crowd_scale.{csv,md%s}\n", o.out.c_str(),
@@ -427,13 +495,13 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Scale benchmark: ODE + plugin on the hopper-fed trough and the bowl feeder at "
       "growing part counts; time per step by stage, contacts, losses, log-log slope"};
-  app.add_option("--trough", o.trough, "part counts of the trough runs (empty: none)")
+  app.add_option("--trough", o.trough, "part counts of the trough runs (a lone 0: none)")
       ->delimiter(',')
-      ->check(CLI::Range(1, 4000))
+      ->check(CLI::Range(0, 4000))
       ->capture_default_str();
-  app.add_option("--bowl", o.bowl, "nut counts of the bowl runs (empty: none)")
+  app.add_option("--bowl", o.bowl, "nut counts of the bowl runs (a lone 0: none)")
       ->delimiter(',')
-      ->check(CLI::Range(1, 4000))
+      ->check(CLI::Range(0, 4000))
       ->capture_default_str();
   app.add_option("--duration", o.duration, "simulated time per run (s)")
       ->check(CLI::Range(1e-3, 1e4))
@@ -453,6 +521,17 @@ int main(int argc, char** argv) {
     o.trough = {20, 40};
     o.bowl = {10, 20};
     o.duration = 1.0;
+  }
+  for (const auto& [name, counts] : {std::pair{"--trough", &o.trough}, {"--bowl", &o.bowl}}) {
+    if (counts->size() == 1 && counts->front() == 0) {
+      counts->clear();  // a lone 0: no runs of that scene
+    } else if (std::count(counts->begin(), counts->end(), 0) > 0) {
+      std::fprintf(stderr,
+                   "crowd_scale_bench: %s: a part count of 0 in a list; counts are in [1, 4000], "
+                   "a lone 0 asks for no run of the scene\n",
+                   name);
+      return 2;
+    }
   }
   for (const auto& [name, value] : {std::pair{"--duration", o.duration}, {"--dt", o.dt}}) {
     if (!std::isfinite(value)) {  // CLI::Range lets NaN through
