@@ -7,6 +7,8 @@
 #include <string>
 #include <utility>
 
+#include "stage_clock.hpp"
+
 namespace rheofeed {
 
 ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders)
@@ -121,6 +123,7 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
 
 void ContactCollider::addContacts(dGeomID o1, dGeomID o2, dContact* contacts, int n,
                                   const double* gap_speed) {
+  const StageClock creation(contact_seconds_);  // contact creation, speculative too (setContactTimer)
   for (int i = 0; i < n; ++i) contacts[i].surface = settings_.default_surface;
   if (surface_ && !surface_(o1, o2, contacts, n)) return;
   if (gap_speed) {

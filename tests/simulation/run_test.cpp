@@ -49,15 +49,7 @@ class Recorder : public RunObserver {
 };
 
 Scene cubeOnFloor(double h, double duration, double sample_interval) {
-  Scene s;
-  s.name = "run loop";
-  s.fixtures.push_back(test::boxFixture("floor", {1, 1, 0.02}));
-  PartSpec p;
-  for (auto& d : p.size) d.mean = 0.02;
-  p.spawn_min = p.spawn_max = {0, 0, 0.01};
-  s.parts.push_back(p);
-  s.solver.time_step = h;
-  s.duration = duration;
+  Scene s = test::cubeOnFloor("run loop", h, duration);
   s.outputs.sample_interval = sample_interval;
   return s;
 }

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Test support: the scene pieces the scene, validation and view tests build again and again - a
-// box fixture whose top face sits at a given point, and the same box vibrating - so that each
-// test states only its own numbers. Header-only; needs rheofeed::scene.
+// box fixture whose top face sits at a given point, the same box vibrating, a cube at rest on a
+// floor - so that each test states only its own numbers. Header-only; needs rheofeed::scene.
 #pragma once
 
 #include <string>
@@ -36,6 +36,22 @@ inline scene::Fixture vibratingBox(const std::string& name, const Vec3& size,
   f.law.vibration.frequency = frequency;
   f.law.vibration.direction = direction;
   return f;
+}
+
+/// A 2 cm cube (steel, the PartSpec defaults) resting with its bottom face on a static 1 m x
+/// 1 m x 2 cm floor whose top is at z = 0, named `name`; steps of `time_step` (s) for
+/// `duration` (s).
+inline scene::Scene cubeOnFloor(const std::string& name, double time_step, double duration) {
+  scene::Scene s;
+  s.name = name;
+  s.fixtures.push_back(boxFixture("floor", {1, 1, 0.02}));
+  scene::PartSpec p;
+  for (auto& d : p.size) d.mean = 0.02;
+  p.spawn_min = p.spawn_max = {0, 0, 0.01};
+  s.parts.push_back(p);
+  s.solver.time_step = time_step;
+  s.duration = duration;
+  return s;
 }
 
 }  // namespace rheofeed::test

@@ -150,6 +150,13 @@ class ContactCollider {
   const std::vector<Joint>& joints() const { return joints_; }
   dJointGroupID jointGroup() const { return group_; }
 
+  /// Stage timing (the simulation's StageTimes, rheofeed/simulation/simulation.hpp): every later
+  /// pass adds to `*seconds` the wall-clock time (s) spent on the pairs dCollide found touching
+  /// after dCollide returned - the SurfaceCallback, FeederSet::driveContacts and the creation
+  /// and attachment of the joints. nullptr (the default) switches it off; no clock is read then.
+  /// `seconds` must outlive the passes that use it.
+  void setContactTimer(double* seconds) { contact_seconds_ = seconds; }
+
  private:
   void handlePair(dGeomID o1, dGeomID o2);
   // Surface callback, cone check, FeederSet and joints for contacts[0..n) of the pair (o1, o2);
@@ -175,9 +182,9 @@ class ContactCollider {
   // swept-volume box (created on first use), and the count of speculative contacts.
   std::vector<std::pair<dGeomID, dGeomID>> paired_;
   std::vector<dGeomID> candidates_;
-  dGeomID sweeper_ = nullptr;
   dGeomID ray_ = nullptr, swept_box_ = nullptr;
   int speculative_count_ = 0;
+  double* contact_seconds_ = nullptr;  // setContactTimer
 };
 
 }  // namespace rheofeed

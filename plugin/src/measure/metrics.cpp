@@ -366,14 +366,19 @@ class RunMeter : public RunObserver {
 RunMetrics measureRun(const Scene& scene, Method method, const Progress& progress,
                       const std::vector<RunObserver*>& observers) {
   std::unique_ptr<Simulation> sim = makeSimulation(scene, method);
+  return measureRun(*sim, scene, progress, observers);
+}
+
+RunMetrics measureRun(Simulation& sim, const Scene& scene, const Progress& progress,
+                      const std::vector<RunObserver*>& observers) {
   const RunSchedule schedule = runSchedule(scene);
-  RunMeter meter(scene, method, schedule);
+  RunMeter meter(scene, sim.method(), schedule);
   HealthReport report(scene.name);
   std::vector<RunObserver*> all{&meter};
   all.insert(all.end(), observers.begin(), observers.end());
   all.push_back(&report);
   const std::clock_t cpu_start = std::clock();
-  runSimulation(*sim, schedule, all, progress);
+  runSimulation(sim, schedule, all, progress);
   RunMetrics& m = meter.metrics();
   m.cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   m.real_time_factor = m.simulated_seconds > 0 ? m.cpu_seconds / m.simulated_seconds : 0;

@@ -21,6 +21,7 @@
 #include "rheofeed/feeder_set.hpp"
 #include "rheofeed/reference/world.hpp"
 #include "simulation_internal.hpp"
+#include "stage_clock.hpp"
 
 namespace rheofeed::scene {
 namespace {
@@ -89,6 +90,7 @@ class OdeSimulation final : public PartSimulation {
       }
       return true;
     });
+    rows_per_contact_ = mu > 0 ? 3 : 1;
     random_state_ = randomSeed(scene.seed);
     listIgnoredSettings();
     spawnDue();
@@ -101,20 +103,42 @@ class OdeSimulation final : public PartSimulation {
   }
 
   // The time at the start of the step is needed by the kinematic law and the plugin.
+  // Stage timing (StageTimes): collision is collide() less the collider's contact creation.
   void advance(double h) override {
     const double t = time();
-    for (const auto& [body, vibration] : vibrating_) driveKinematic(body, vibration, t, h);
+    StageTimes& times = stage_times_;
+    const bool timing = stageTiming();
+    collider_->setContactTimer(timing ? &times.contacts : nullptr);
+    const double contacts_before = times.contacts;
+    {
+      const StageClock solve(timing ? &times.solve : nullptr);
+      for (const auto& [body, vibration] : vibrating_) driveKinematic(body, vibration, t, h);
+    }
     const unsigned long outside = dRandGetSeed();  // the application's generator state
     dRandSetSeed(random_state_);
-    collider_->collide(space_, t, h);  // laws frozen on [t, t + h] (secant surface velocity)
-    health_.speculative_contacts += collider_->speculativeContactCount();
-    if (scene_.solver.ode_quickstep) {
-      dWorldQuickStep(world_, h);
-    } else {
-      dWorldStep(world_, h);
+    {
+      double collide_seconds = 0;
+      {
+        const StageClock collide(timing ? &collide_seconds : nullptr);
+        collider_->collide(space_, t, h);  // laws frozen on [t, t + h] (secant surface velocity)
+      }
+      health_.speculative_contacts += collider_->speculativeContactCount();
+      times.collision += collide_seconds - (times.contacts - contacts_before);
+    }
+    {
+      const StageClock solve(timing ? &times.solve : nullptr);
+      if (scene_.solver.ode_quickstep) {
+        dWorldQuickStep(world_, h);
+      } else {
+        dWorldStep(world_, h);
+      }
     }
     random_state_ = dRandGetSeed();
     dRandSetSeed(outside);
+    if (timing) {
+      times.contact_count += collider_->contactCount();
+      times.constraint_rows += long(collider_->contactCount()) * rows_per_contact_;
+    }
   }
 
   PartState partState(int i) const override {
@@ -238,6 +262,9 @@ class OdeSimulation final : public PartSimulation {
   std::vector<std::pair<dBodyID, Vibration>> vibrating_;
   std::vector<dBodyID> parts_;
   unsigned long random_state_ = 0;  // this simulation's state of ODE's generator
+  // Constraint rows of one contact joint (StageTimes::constraint_rows): every contact gets the
+  // scene's mu (the surface callback), so 1 normal row plus 2 friction rows when mu > 0.
+  int rows_per_contact_ = 1;
 };
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "rheofeed/reference/world.hpp"
 #include "rheofeed/simulation/reference_simulation.hpp"
 #include "simulation_internal.hpp"
+#include "stage_clock.hpp"
 
 namespace rheofeed::scene {
 namespace {
@@ -65,7 +66,15 @@ class ReferenceSimulation final : public PartSimulation {
 
   // Counts the steps whose contact solve cannot be trusted fully (RunHealth).
   void advance(double h) override {
-    const reference::StepReport report = world_->step(h);
+    reference::StepReport report;
+    {
+      const StageClock solve(stageTiming() ? &stage_times_.solve : nullptr);  // StageTimes
+      report = world_->step(h);
+    }
+    if (stageTiming()) {
+      stage_times_.contact_count += report.contacts;
+      stage_times_.constraint_rows += 3L * report.contacts;  // the cone: normal + 2 tangential
+    }
     // Bodies the world found non-finite are disabled there at their last finite pose: counted
     // here as non-finite parts (their parked state alone would look fine).
     for (const BodyId body : report.nonfinite_bodies) {

@@ -61,6 +61,7 @@
 #include <sstream>
 
 #include "simulation_internal.hpp"
+#include "stage_clock.hpp"
 
 namespace rheofeed::scene {
 namespace {
@@ -572,6 +573,8 @@ void PartSimulation::remove(std::size_t i, PartCheck check, const PartState& sta
 void PartSimulation::step() {
   const double h = scene_.solver.time_step;
   advance(h);
+  if (stage_timing_) ++stage_times_.steps;
+  const StageClock checks(stage_timing_ ? &stage_times_.checks : nullptr);  // to the end
   time_ = ++steps_ * h;
   health_.steps = steps_;
   if (!local_laws_.empty()) {

@@ -36,6 +36,8 @@ class PartSimulation : public Simulation {
   ContactTotals contactTotals() const final { return totals_; }
   Method method() const final { return method_; }
   const RunHealth& health() const final { return health_; }
+  void setStageTiming(bool on) final { stage_timing_ = on; }
+  const StageTimes& stageTimes() const final { return stage_times_; }
 
  protected:
   PartSimulation(const Scene& scene, Method method);
@@ -78,6 +80,11 @@ class PartSimulation : public Simulation {
 
   const Scene scene_;
   RunHealth health_;
+  /// Stage timing (Simulation::setStageTiming): engines add their stages' seconds and contact
+  /// counts to stage_times_ only while stageTiming() is true; StageClock reads no clock when
+  /// given nullptr (`stageTiming() ? &stage_times_.solve : nullptr`).
+  bool stageTiming() const { return stage_timing_; }
+  StageTimes stage_times_;
 
  private:
   struct Track {
@@ -147,6 +154,7 @@ class PartSimulation : public Simulation {
   double time_ = 0;
   long steps_ = 0;
   ContactTotals totals_;
+  bool stage_timing_ = false;
 };
 
 /// "(x, y, z) m" with 6 significant digits (stderr reports).

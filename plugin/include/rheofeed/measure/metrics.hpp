@@ -160,4 +160,10 @@ struct RunMetrics {
 RunMetrics measureRun(const Scene& scene, Method method, const Progress& progress = {},
                       const std::vector<RunObserver*>& observers = {});
 
+/// measureRun on a simulation the caller built from `scene` (makeSimulation(scene, method),
+/// not stepped yet) and set up, e.g. with stage timing on (Simulation::setStageTiming); the
+/// method is sim.method(). The same run, measures and reports as above.
+RunMetrics measureRun(Simulation& sim, const Scene& scene, const Progress& progress = {},
+                      const std::vector<RunObserver*>& observers = {});
+
 }  // namespace rheofeed::scene

@@ -234,6 +234,38 @@ double partSpeed(const PartState& state, double radius);
 /// geometry and are checked by the simulation itself.
 PartCheck checkPartState(const PartState& state, const SceneLimits& limits, double radius);
 
+/// Where a simulation's steps spend their time, summed over the steps taken while stage timing
+/// was on (Simulation::setStageTiming), with the contacts of those steps. For benchmarks
+/// (demos/bench/crowd_scale_bench.cpp); off by default, when no clock is read.
+///
+/// Times are wall-clock seconds (steady clock) of the stages of Simulation::step, in order:
+///   ODE (ode_rheonomic, ode_full_vibration)   collision: dSpaceCollide with dCollide of every
+///     candidate pair (broad and narrow phase; ContactCollider::collide less `contacts`,
+///     so also the emptying of the last step's joint group);
+///     contacts: what follows dCollide for the pairs in touch - surface parameters, the
+///     plugin's FeederSet::driveContacts, dJointCreateContact and dJointAttach
+///     (ContactCollider::setContactTimer); solve: dWorldQuickStep (or dWorldStep), with the
+///     kinematic drive of full-vibration feeders;
+///   reference engine                           solve: its whole step (collision and contact
+///     building included: World::step does not split them); collision and contacts stay 0;
+///   both                                       checks: the part checks after the step
+///     (RunHealth: limits, tunnelling rays, leaving the feeder), the contact totals and the
+///     spawning of the parts that are due.
+/// What the run loop (run.hpp) does around step() - observers, metrics, progress - is not in
+/// any of them: a caller that times its loop gets it as the remainder.
+struct StageTimes {
+  long steps = 0;          ///< steps timed
+  double collision = 0;    ///< (s)
+  double contacts = 0;     ///< (s)
+  double solve = 0;        ///< (s)
+  double checks = 0;       ///< (s)
+  long contact_count = 0;  ///< contact joints (ODE) or contacts (reference), summed over the steps
+  /// Constraint rows of those contacts, summed over the steps: ODE's dxJointContact::getInfo1
+  /// counts 1 normal row plus 2 friction rows when mu > 0 (no rolling friction here); the
+  /// reference's cone has 3 rows per contact.
+  long constraint_rows = 0;
+};
+
 class Simulation {
  public:
   virtual ~Simulation() = default;
@@ -256,6 +288,12 @@ class Simulation {
   virtual Method method() const = 0;
   /// What the run lost, could not trust or ignored so far.
   virtual const RunHealth& health() const = 0;
+  /// Switches stage timing on or off (off at construction); switching it on again keeps the
+  /// sums. Timing reads the clock a few times per step and per touching geom pair; it does
+  /// not change the results (the same part states, bit for bit).
+  virtual void setStageTiming(bool on) = 0;
+  /// The stage times summed so far (StageTimes; all zero while timing was never on).
+  virtual const StageTimes& stageTimes() const = 0;
 };
 
 /// Builds the scene for `method`. Throws std::invalid_argument for an invalid scene or a
