@@ -172,7 +172,7 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
     const Vec3 p0{r0 * std::cos(phi0), r0 * std::sin(phi0), 0};
     const Vec3 p1{r1 * std::cos(phi1), r1 * std::sin(phi1), 0};
     const Vec3 d = p1 - p0;
-    const double blade_height = 0.020, blade_thickness = 0.003;
+    const double blade_height = 0.020, blade_thickness = 0.012;
     const double bottom = trackTop(phi1) + kWiperClearance;
     bowl.geoms.push_back(
         box({norm(d), blade_thickness, blade_height},
@@ -183,7 +183,7 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
     // edge down inwards at 35 degrees (> atan(mu), so nuts slide) to the cone. A wiped nut
     // falls about 10 mm onto it instead of 50 mm onto the cone's foot (1 m/s, 10 mm per step:
     // its centre crossed the cone's surface for a step).
-    const double chute_slope = 35 * kDeg, chute_thickness = 0.004;
+    const double chute_slope = 35 * kDeg, chute_thickness = 0.012;
     const double r_top = kInnerRadius - kTrackWidth - 0.001;
     const double z_top = trackTop(phi0) - kTrackThickness - 0.003;
     // Where the plate's top meets the cone: z_top - (r_top - r) tan(chute) = cone(r).
@@ -211,19 +211,18 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
         {kTrackWidth + 0.001, kOutletLength, kTrackThickness},
         composed(roll, Pose{},
                  Vec3{x, 0.5 * kOutletLength, top} - roll.rotate({0, 0, 0.5 * kTrackThickness}))));
-    const double rail_height = 0.012, rail = 0.003;
-    bowl.geoms.push_back(
-        box({rail, kOutletLength, rail_height},
-            Pose::axisAngle({0, 0, 1}, 0,
-                            {kInnerRadius + 0.001 + 0.5 * rail, 0.5 * kOutletLength,
-                             top + 0.5 * rail_height - 0.002})));
-    // The inner rail runs the whole length: the field w x r has an inward component along the
+    // Rails 10 mm above the track and 6 mm into the cut wall below it (no seam for a nut). The
+    // inner one runs the whole length too: the field w x r has an inward component along the
     // straight track, and a nut pushed off its inner edge would fall 60 mm into the bowl.
-    bowl.geoms.push_back(
-        box({rail, kOutletLength, rail_height},
-            Pose::axisAngle({0, 0, 1}, 0,
-                            {kInnerRadius - kTrackWidth - 0.5 * rail, 0.5 * kOutletLength,
-                             top + 0.5 * rail_height - 0.002})));
+    const double rail_top = 0.010, rail_bottom = kOutletWallTop - 0.006 - top,
+                 rail = 0.011;  // as thick as a falling nut needs (the scene check)
+    for (double rail_x :
+         {kInnerRadius + 0.001 + 0.5 * rail, kInnerRadius - kTrackWidth - 0.5 * rail}) {
+      bowl.geoms.push_back(box(
+          {rail, kOutletLength, rail_top - rail_bottom},
+          Pose::axisAngle({0, 0, 1}, 0,
+                          {rail_x, 0.5 * kOutletLength, top + 0.5 * (rail_top + rail_bottom)})));
+    }
   }
 
   // Screw vibration at 50 Hz: 0.15 mm vertical (A w^2 = 1.5 g: the nuts hop) and 0.17 degrees
@@ -244,12 +243,13 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
   // M6 nut blanks (10 mm across flats, 5 mm thick, 2.3 g) as ODE cylinders of the hexagon's
   // area (radius 5.25 mm) and the blank's mass: ODE's cylinder-box test gives a flat nut its
   // full contact patch. The nut mesh (demos/meshes/hex_nut_m6.obj) against these boxes sank
-  // 1.8 mm into the ramp and stuck while lying flat (demos/results/bowl_feeder.md). 3 % spread.
+  // 1.8 mm into the ramp and stuck while lying flat (demos/results/bowl_feeder.md). 3 % spread, cut
+  // at +-5 %.
   PartSpec p;
   p.name = "m6_nuts";
   p.shape = Shape::Kind::Cylinder;
-  p.size[0] = {0.00525, 0.00016, 0.0047, 0.0058};  // radius (m)
-  p.size[1] = {0.005, 0.00015, 0.0045, 0.0055};    // thickness (m)
+  p.size[0] = {0.00525, 0.00016, 0.005, 0.0055};   // radius (m)
+  p.size[1] = {0.005, 0.00015, 0.00475, 0.00525};  // thickness (m)
   p.density = 5290;  // 2.29 g at the mean size, the steel blank with its 6 mm hole
   p.random_orientation = true;
   p.count = nuts;
