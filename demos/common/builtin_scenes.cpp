@@ -103,47 +103,23 @@ Scene turntableScene(double omega) {
 Scene helicalRampScene(double omega) {
   Scene s;
   s.name = omega >= 0 ? "helical_ramp_up" : "helical_ramp_down";
-  constexpr double kRadius = 0.3, kPitch = 0.1, kWidth = 0.1;
-  constexpr int kSegments = 48;  // per turn, 1.5 turns
-  const double slope = std::atan(kPitch / (2 * kPi * kRadius));
+  HelicalTrack track;  // radius 0.3 m, pitch 0.1 m per turn, 0.1 m wide, 2 cm thick
+  track.radius = 0.3;
+  track.width = 0.1;
+  track.thickness = 0.02;
+  track.pitch = 0.1;
+  track.turns = 1.5;
+  track.segments_per_turn = 48;
   Fixture ramp;
   ramp.name = "ramp";
-  const int total = kSegments * 3 / 2;
-  const double seg_angle = 2 * kPi / kSegments;
-  const double seg_length = 2 * kRadius * std::tan(seg_angle / 2) / std::cos(slope) * 1.05;
-  for (int i = 0; i < total; ++i) {
-    const double phi = (i + 0.5) * seg_angle;  // angle of the segment centre
-    const double z = kPitch * phi / (2 * kPi);
-    // Segment frame: x along the tangent (rising), y radial-in, z up; tilt by `slope` about
-    // the radial axis, then turn to phi.
-    const Pose heading = Pose::axisAngle({0, 0, 1}, phi + kPi / 2, {0, 0, 0});
-    // Turning the tangent about the outward radial axis r by +slope lifts it (r x t = +z).
-    const Vec3 radial = heading.rotate({0, -1, 0});
-    const Pose tilt = Pose::axisAngle(radial, slope, {0, 0, 0});
-    Pose p;
-    // Compose tilt * heading.
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) {
-        double sum = 0;
-        for (int k = 0; k < 3; ++k) sum += tilt.rotation[3 * r + k] * heading.rotation[3 * k + c];
-        p.rotation[3 * r + c] = sum;
-      }
-    }
-    const Vec3 centre{kRadius * std::cos(phi), kRadius * std::sin(phi), z};
-    p.position = centre - p.rotate({0, 0, 0.01});  // 2 cm thick, top face through the helix
-    Fixture::Geom g;
-    g.shape.kind = Shape::Kind::Box;
-    g.shape.size = {seg_length, kWidth, 0.02};
-    g.pose = p;
-    ramp.geoms.push_back(g);
-  }
+  ramp.geoms = helicalTrack(track);
   ramp.law.kind = FeederLaw::Kind::Drift;
   ramp.law.drift.angular = {0, 0, omega};
   s.fixtures.push_back(ramp);
   // A part on the first half turn.
   const double phi0 = kPi / 2;
-  PartSpec part = cube(0.03, {kRadius * std::cos(phi0), kRadius * std::sin(phi0),
-                              kPitch * phi0 / (2 * kPi) + 0.017});
+  PartSpec part = cube(0.03, {track.radius * std::cos(phi0), track.radius * std::sin(phi0),
+                              track.pitch * phi0 / (2 * kPi) + 0.017});
   part.density = 1000;
   s.parts.push_back(part);
   s.material.mu = 0.8;

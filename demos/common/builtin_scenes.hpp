@@ -59,6 +59,39 @@ Scene linearTroughScene(int count = 60, double rate = 20, double amplitude = 0.2
 /// lying flat in one layer spread over its first 0.5 m, touching now and then.
 Scene troughScene(int count = 40, bool heap = false);
 
+/// A helical track about the world z axis, right-handed (it rises counter-clockwise seen from
+/// above), made of tilted boxes (helicalTrack).
+struct HelicalTrack {
+  double radius = 0.3;         ///< centre line of the track (m)
+  double width = 0.1;          ///< radial width of the boxes (m)
+  double thickness = 0.02;     ///< box thickness below the top surface (m)
+  double pitch = 0.1;          ///< rise per turn (m)
+  double turns = 1.5;          ///< from azimuth 0 (on +x)
+  int segments_per_turn = 48;  ///< boxes per turn
+  double z_start = 0;          ///< height of the top surface at azimuth 0 (m)
+  double outward_tilt = 0;     ///< roll of the top surface, falling outwards (rad)
+};
+
+/// The boxes of `track`: each one's top face a chord of the helix through the centre line,
+/// 5 % longer than its share so that neighbours overlap.
+std::vector<Fixture::Geom> helicalTrack(const HelicalTrack& track);
+
+/// A vibratory bowl feeder built from ODE primitives (bowl_scene.cpp): inner radius 150 mm,
+/// a box floor (top at z = 10 mm), a central cone of 36 box facets (25 degrees, 25 mm thick,
+/// from r = 10 mm at z = 63 mm down to the floor at r = 124 mm), a wall of 48 boxes (10 mm
+/// thick, 100 mm high), and a helical ramp of 128 boxes (20 mm wide, r = 130..150 mm, 12 mm
+/// thick, pitch 30 mm, 2 turns counter-clockwise from the floor at azimuth 0, its top falling
+/// 3 degrees towards the wall). Screw vibration 50 Hz, 0.15 mm vertical, 0.17 degrees torsion;
+/// rheonomic runs use the calibrated drift 0.313 rad/s about +z at h = 0.01 s. `nuts` M6 nuts as
+/// cylinders (radius 5.25 mm, 5 mm thick, 2.3 g) dropped one by one at `rate` parts/s (> 0)
+/// from at most 12 mm above the cone. With `outlet`: a wiper across the last turn (6.5 mm above
+/// the track: nuts lying flat pass, nuts on edge or on another nut are pushed inwards off the
+/// track onto a return chute), a straight outlet track with rails leaving tangentially at the
+/// top (azimuth 0, z = 70 mm, along +y) through a cut in the wall, and an exit plane outside the
+/// bowl (tangent to r = 175 mm at azimuth 45 degrees). `duration` (s); mu = 0.3. Named
+/// bowl_feeder_fill above 12 nuts, else bowl_feeder_primitives.
+Scene bowlFeederScene(int nuts = 12, double rate = 4, bool outlet = true, double duration = 60);
+
 /// A static ring of `count` upright boxes about the world z axis (a turntable's rim): box centres
 /// on a circle of radius `centre_radius` (m) at height `z_centre` (m), each `thickness` (m)
 /// radially and `height` (m) tall, and wide enough tangentially to close the ring at
