@@ -490,6 +490,7 @@ StabilityCase turntableCase(double omega, bool rim, double duration) {
   if (!rim && omega * omega * 0.05 > 0.8 * kG) {
     b.kase().note = "w^2 r > mu g beyond r = " + formatNumber(0.8 * kG / (omega * omega)) +
                     " m: parts fly off the table (lost, must be reported)";
+    b.kase().expect_losses = true;
   }
   return b.finish();
 }

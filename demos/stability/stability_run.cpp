@@ -366,6 +366,9 @@ RunRecord runCase(const StabilityCase& c, Method method, const Limits& limits) {
   if (r.lost_measured > r.lost_reported) {
     fail(std::to_string(r.lost_measured) + " lost (" + r.lost_how + "), " +
          std::to_string(r.lost_reported) + " reported");
+  } else if (r.lost_measured > 0 && c.expect_losses) {
+    addCause(r, std::to_string(r.lost_measured) + " lost (" + r.lost_how +
+                    "), all reported, as the case's physics expects");
   } else if (r.lost_measured > 0) {
     limit(std::to_string(r.lost_measured) + " lost (" + r.lost_how + "), all reported");
   }

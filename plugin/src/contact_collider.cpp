@@ -203,6 +203,11 @@ double smallestHalfExtent(dGeomID g) {
       dGeomCapsuleGetParams(g, &r, &l);
       return r;
     }
+    case dCylinderClass: {
+      dReal r, l;
+      dGeomCylinderGetParams(g, &r, &l);
+      return std::min(r, 0.5 * l);
+    }
     default: {
       dReal b[6];
       dGeomGetAABB(g, b);
@@ -241,6 +246,33 @@ int leadingPoints(dGeomID g, const dReal dir[3], dReal out[8][3]) {
         for (int k = 0; k < 3; ++k) out[e][k] += rad * dir[k];
       }
       return 2;
+    }
+    case dCylinderClass: {
+      // Four rim points of each end: the one furthest along the motion and its quarter turns
+      // (a cylinder moving along its axis leads with a whole face).
+      dReal rad, len;
+      dGeomCylinderGetParams(g, &rad, &len);
+      const double axis[3] = {r[2], r[6], r[10]};  // local z in world
+      const double along = dir[0] * axis[0] + dir[1] * axis[1] + dir[2] * axis[2];
+      double u[3] = {dir[0] - along * axis[0], dir[1] - along * axis[1], dir[2] - along * axis[2]};
+      double nu = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+      if (nu < 1e-9) {  // along the axis: any radial direction
+        u[0] = r[0], u[1] = r[4], u[2] = r[8];
+        nu = 1;
+      }
+      for (double& x : u) x /= nu;
+      const double w[3] = {axis[1] * u[2] - axis[2] * u[1], axis[2] * u[0] - axis[0] * u[2],
+                           axis[0] * u[1] - axis[1] * u[0]};
+      int n = 0;
+      for (int e = 0; e < 2; ++e) {
+        const double h = (e ? 0.5 : -0.5) * len;
+        for (int q = 0; q < 4; ++q) {
+          const double cu = q == 0 ? 1 : q == 2 ? -1 : 0, cw = q == 1 ? 1 : q == 3 ? -1 : 0;
+          for (int k = 0; k < 3; ++k) out[n][k] = c[k] + h * axis[k] + rad * (cu * u[k] + cw * w[k]);
+          ++n;
+        }
+      }
+      return n;
     }
     default: {
       dReal b[6];
@@ -329,6 +361,10 @@ void ContactCollider::sweepGeom(dGeomID geom, dSpaceID root, double step) {
     if (std::binary_search(paired_.begin(), paired_.end(), key)) continue;
     int n = 0;
     for (int i = 0; i < np && n < static_cast<int>(contacts.size()) && n < 8; ++i) {
+      if (dGeomGetClass(other) == dBoxClass &&
+          dGeomBoxPointDepth(other, points[i][0], points[i][1], points[i][2]) >= 0) {
+        continue;  // starts inside the box (a bounding-box corner): no gap to measure
+      }
       dGeomRaySet(ray_, points[i][0], points[i][1], points[i][2], dir[0], dir[1], dir[2]);
       dContactGeom hit;
       if (dCollide(ray_, other, 1, &hit, sizeof hit) < 1) continue;
