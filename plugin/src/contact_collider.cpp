@@ -36,7 +36,7 @@ ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders, const Setti
 
 ContactCollider::~ContactCollider() {
   if (ray_) dGeomDestroy(ray_);
-  if (swept_box_) dGeomDestroy(swept_box_);
+  for (dGeomID p : proxies_) dGeomDestroy(p);
   dJointGroupDestroy(group_);
 }
 
@@ -48,6 +48,8 @@ void ContactCollider::clearJoints() {
   dJointGroupEmpty(group_);
   joints_.clear();
   paired_.clear();
+  sweeps_.clear();
+  sweep_of_proxy_.clear();
   feedback_used_ = 0;
   speculative_count_ = 0;
 }
@@ -63,12 +65,23 @@ void ContactCollider::collide(dSpaceID space, double time, double step) {
   rethrowPendingError();           // an error of a manual pass is not lost
   feeders_.beginStep(time, step);  // first: a refused time or step leaves everything as it was
   clearJoints();
-  collideWithin(space);
-  if (settings_.speculative && step > 0 && !error_) {
+  const bool speculative = settings_.speculative && step > 0;
+  if (speculative) {
     try {
-      sweepFastBodies(space, step);
+      placeSweeps(space, step);  // the fast bodies' swept boxes join the broad phase
     } catch (...) {
       error_ = std::current_exception();
+    }
+  }
+  if (!error_) collideWithin(space);
+  if (speculative) {
+    for (const Sweep& s : sweeps_) dSpaceRemove(dGeomGetSpace(s.proxy), s.proxy);
+    if (!error_) {
+      try {
+        castSweeps(step);
+      } catch (...) {
+        error_ = std::current_exception();
+      }
     }
   }
   if (error_) {
@@ -107,6 +120,15 @@ void ContactCollider::nearCallback(void* data, dGeomID o1, dGeomID o2) {
 }
 
 void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
+  if (!sweep_of_proxy_.empty()) {
+    const auto p1 = sweep_of_proxy_.find(o1), p2 = sweep_of_proxy_.find(o2);
+    if (p1 != sweep_of_proxy_.end() || p2 != sweep_of_proxy_.end()) {
+      if (p1 != sweep_of_proxy_.end() && p2 != sweep_of_proxy_.end()) return;  // two proxies
+      Sweep& s = sweeps_[p1 != sweep_of_proxy_.end() ? p1->second : p2->second];
+      s.candidates.push_back(p1 != sweep_of_proxy_.end() ? o2 : o1);
+      return;
+    }
+  }
   dBodyID b1 = dGeomGetBody(o1);
   dBodyID b2 = dGeomGetBody(o2);
   if (!b1 && !b2) return;  // two static geoms: nothing to constrain
@@ -289,102 +311,102 @@ int leadingPoints(dGeomID g, const dReal dir[3], dReal out[8][3]) {
 
 }  // namespace
 
-void ContactCollider::sweepFastBodies(dSpaceID space, double step) {
-  std::sort(paired_.begin(), paired_.end());
+void ContactCollider::placeSweeps(dSpaceID space, double step) {
+  if (space == nullptr) return;
   const int count = dSpaceGetNumGeoms(space);
   std::vector<dGeomID> geoms;
   geoms.reserve(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i) geoms.push_back(dSpaceGetGeom(space, i));
   for (dGeomID g : geoms) {
     if (dGeomIsSpace(g)) {
-      sweepFastBodies(reinterpret_cast<dSpaceID>(g), step);
-    } else {
-      sweepGeom(g, space, step);
+      placeSweeps(reinterpret_cast<dSpaceID>(g), step);
+      continue;
     }
+    dBodyID body = dGeomGetBody(g);
+    if (!body || !dBodyIsEnabled(body) || dBodyIsKinematic(body)) continue;
+    const dReal* v = dBodyGetLinearVel(body);
+    double end_v[3] = {v[0], v[1], v[2]};
+    if (dBodyGetGravityMode(body)) {
+      dVector3 gravity;
+      dWorldGetGravity(world_, gravity);
+      for (int k = 0; k < 3; ++k) end_v[k] += gravity[k] * step;
+    }
+    const double speed =
+        std::sqrt(end_v[0] * end_v[0] + end_v[1] * end_v[1] + end_v[2] * end_v[2]);
+    const double travel = speed * step;
+    if (!(travel > settings_.speculative_fraction * smallestHalfExtent(g))) continue;
+
+    // The swept box: the geom's box and that box moved by the travel. It joins the geom's space
+    // for the regular pass, which finds its candidates (handlePair) at the broad phase's cost.
+    Sweep s;
+    s.geom = g;
+    s.travel = travel;
+    for (int k = 0; k < 3; ++k) s.dir[k] = end_v[k] / speed;
+    dReal b[6];
+    dGeomGetAABB(g, b);
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(b[2 * k], b[2 * k] + s.dir[k] * travel);
+      hi[k] = std::max(b[2 * k + 1], b[2 * k + 1] + s.dir[k] * travel);
+    }
+    if (sweeps_.size() == proxies_.size()) proxies_.push_back(dCreateBox(nullptr, 1, 1, 1));
+    s.proxy = proxies_[sweeps_.size()];
+    dGeomBoxSetLengths(s.proxy, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    dGeomSetPosition(s.proxy, 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]),
+                     0.5 * (lo[2] + hi[2]));
+    dSpaceAdd(space, s.proxy);
+    sweep_of_proxy_[s.proxy] = sweeps_.size();
+    sweeps_.push_back(std::move(s));
   }
 }
 
-void ContactCollider::candidateCallback(void* data, dGeomID o1, dGeomID o2) {
-  auto* self = static_cast<ContactCollider*>(data);
-  dGeomID other = o1 == self->swept_box_ ? o2 : o1;
-  if (dGeomIsSpace(other)) {
-    dSpaceCollide2(self->swept_box_, other, data, &ContactCollider::candidateCallback);
-    return;
-  }
-  self->candidates_.push_back(other);
-}
-
-void ContactCollider::sweepGeom(dGeomID geom, dSpaceID root, double step) {
-  dBodyID body = dGeomGetBody(geom);
-  if (!body || !dBodyIsEnabled(body) || dBodyIsKinematic(body)) return;
-  const dReal* v = dBodyGetLinearVel(body);
-  dVector3 end_v = {v[0], v[1], v[2], 0};
-  if (dBodyGetGravityMode(body)) {
-    dVector3 g;
-    dWorldGetGravity(world_, g);
-    for (int k = 0; k < 3; ++k) end_v[k] += g[k] * step;
-  }
-  const double speed = std::sqrt(end_v[0] * end_v[0] + end_v[1] * end_v[1] + end_v[2] * end_v[2]);
-  const double travel = speed * step;
-  if (!(travel > settings_.speculative_fraction * smallestHalfExtent(geom))) return;
-  const dReal dir[3] = {end_v[0] / speed, end_v[1] / speed, end_v[2] / speed};
-
-  // Candidates: the geoms whose boxes meet the swept box (the geom's box and its box moved by
-  // the travel), but not the geom's own body and not pairs the regular pass already made.
-  dReal b[6];
-  dGeomGetAABB(geom, b);
-  double lo[3], hi[3];
-  for (int k = 0; k < 3; ++k) {
-    lo[k] = std::min(b[2 * k], b[2 * k] + dir[k] * travel);
-    hi[k] = std::max(b[2 * k + 1], b[2 * k + 1] + dir[k] * travel);
-  }
-  if (!swept_box_) swept_box_ = dCreateBox(nullptr, 1, 1, 1);
-  dGeomBoxSetLengths(swept_box_, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-  dGeomSetPosition(swept_box_, 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]));
-  candidates_.clear();
-  dSpaceCollide2(swept_box_, reinterpret_cast<dGeomID>(root), this,
-                 &ContactCollider::candidateCallback);
-  if (candidates_.empty()) return;
-
-  dReal points[8][3];
-  const int np = leadingPoints(geom, dir, points);
+void ContactCollider::castSweeps(double step) {
+  std::sort(paired_.begin(), paired_.end());
   if (!ray_) {
-    ray_ = dCreateRay(nullptr, travel);
+    ray_ = dCreateRay(nullptr, 1);
     dGeomRaySetClosestHit(ray_, 1);
   }
-  dGeomRaySetLength(ray_, travel);
   std::vector<dContact>& contacts = buffer_;
-  double gap_speed[8];
-  for (dGeomID other : candidates_) {
-    if (other == geom || dGeomGetBody(other) == body) continue;
-    const auto key = std::make_pair(geom < other ? geom : other, geom < other ? other : geom);
-    if (std::binary_search(paired_.begin(), paired_.end(), key)) continue;
-    int n = 0;
-    for (int i = 0; i < np && n < static_cast<int>(contacts.size()) && n < 8; ++i) {
-      if (dGeomGetClass(other) == dBoxClass &&
-          dGeomBoxPointDepth(other, points[i][0], points[i][1], points[i][2]) >= 0) {
-        continue;  // starts inside the box (a bounding-box corner): no gap to measure
+  for (const Sweep& s : sweeps_) {
+    if (s.candidates.empty()) continue;
+    const dGeomID geom = s.geom;
+    const dBodyID body = dGeomGetBody(geom);
+    dReal points[8][3];
+    const int np = leadingPoints(geom, s.dir, points);
+    dGeomRaySetLength(ray_, s.travel);
+    double gap_speed[8];
+    for (dGeomID other : s.candidates) {
+      if (other == geom || dGeomGetBody(other) == body) continue;
+      const auto key = std::make_pair(geom < other ? geom : other, geom < other ? other : geom);
+      if (std::binary_search(paired_.begin(), paired_.end(), key)) continue;
+      int n = 0;
+      for (int i = 0; i < np && n < static_cast<int>(contacts.size()) && n < 8; ++i) {
+        if (dGeomGetClass(other) == dBoxClass &&
+            dGeomBoxPointDepth(other, points[i][0], points[i][1], points[i][2]) >= 0) {
+          continue;  // starts inside the box (a bounding-box corner): no gap to measure
+        }
+        dGeomRaySet(ray_, points[i][0], points[i][1], points[i][2], s.dir[0], s.dir[1], s.dir[2]);
+        dContactGeom hit;
+        if (dCollide(ray_, other, 1, &hit, sizeof hit) < 1) continue;
+        double along =
+            hit.normal[0] * s.dir[0] + hit.normal[1] * s.dir[1] + hit.normal[2] * s.dir[2];
+        const double sign = along > 0 ? -1.0 : 1.0;  // the normal out of `other`, against the motion
+        along = std::fabs(along);
+        if (!(along > 1e-6)) continue;  // grazing: the motion does not close it
+        dContactGeom& c = contacts[static_cast<std::size_t>(n)].geom;
+        for (int k = 0; k < 3; ++k) {
+          c.pos[k] = hit.pos[k];
+          c.normal[k] = sign * hit.normal[k];  // into g1 = the swept geom
+        }
+        c.depth = 0;
+        c.g1 = geom;
+        c.g2 = other;
+        c.side1 = c.side2 = -1;
+        gap_speed[n] = hit.depth * along / step;  // the gap along the normal, per step
+        ++n;
       }
-      dGeomRaySet(ray_, points[i][0], points[i][1], points[i][2], dir[0], dir[1], dir[2]);
-      dContactGeom hit;
-      if (dCollide(ray_, other, 1, &hit, sizeof hit) < 1) continue;
-      double along = hit.normal[0] * dir[0] + hit.normal[1] * dir[1] + hit.normal[2] * dir[2];
-      const double sign = along > 0 ? -1.0 : 1.0;  // the normal out of `other`, against the motion
-      along = std::fabs(along);
-      if (!(along > 1e-6)) continue;                // grazing: the motion does not close it
-      dContactGeom& c = contacts[static_cast<std::size_t>(n)].geom;
-      for (int k = 0; k < 3; ++k) {
-        c.pos[k] = hit.pos[k];
-        c.normal[k] = sign * hit.normal[k];  // into g1 = the swept geom
-      }
-      c.depth = 0;
-      c.g1 = geom;
-      c.g2 = other;
-      c.side1 = c.side2 = -1;
-      gap_speed[n] = hit.depth * along / step;  // the gap along the normal, per step
-      ++n;
+      if (n > 0) addContacts(geom, other, contacts.data(), n, gap_speed);
     }
-    if (n > 0) addContacts(geom, other, contacts.data(), n, gap_speed);
   }
 }
 

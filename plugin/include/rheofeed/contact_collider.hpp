@@ -58,6 +58,7 @@
 #include <deque>
 #include <exception>
 #include <functional>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -164,10 +165,10 @@ class ContactCollider {
   // `gap_speed` (m/s, one per contact) non-null marks speculative contacts (motionN = -gap/h).
   void addContacts(dGeomID o1, dGeomID o2, dContact* contacts, int n, const double* gap_speed);
   void collideWithin(dSpaceID space);
-  // The speculative pass over `space` (and its sub-spaces) for a step of `step` s.
-  void sweepFastBodies(dSpaceID space, double step);
-  void sweepGeom(dGeomID geom, dSpaceID root, double step);
-  static void candidateCallback(void* data, dGeomID o1, dGeomID o2);
+  // Speculative contacts: the swept box of each fast body's geom joins its space for the
+  // regular pass (placeSweeps), which collects the geoms it meets; then the rays (castSweeps).
+  void placeSweeps(dSpaceID space, double step);
+  void castSweeps(double step);
 
   dWorldID world_;
   FeederSet& feeders_;
@@ -179,11 +180,20 @@ class ContactCollider {
   std::size_t feedback_used_ = 0;
   std::vector<Joint> joints_;
   std::exception_ptr error_;  // first exception caught in the near callback, not yet rethrown
-  // Speculative pass: the regular pass's pairs, the swept geom's candidates, the ray and the
-  // swept-volume box (created on first use), and the count of speculative contacts.
+  // Speculative pass: the regular pass's pairs; each fast geom's sweep (its swept box, a
+  // proxy geom of ours, and the geoms the box met); the proxies' pool and the ray (created on
+  // first use); the count of speculative contacts.
+  struct Sweep {
+    dGeomID geom = nullptr, proxy = nullptr;
+    double dir[3] = {0, 0, 0};  // unit direction of the motion (world)
+    double travel = 0;          // m in the step
+    std::vector<dGeomID> candidates;
+  };
   std::vector<std::pair<dGeomID, dGeomID>> paired_;
-  std::vector<dGeomID> candidates_;
-  dGeomID ray_ = nullptr, swept_box_ = nullptr;
+  std::vector<Sweep> sweeps_;
+  std::unordered_map<dGeomID, std::size_t> sweep_of_proxy_;
+  std::vector<dGeomID> proxies_;
+  dGeomID ray_ = nullptr;
   int speculative_count_ = 0;
   double* contact_seconds_ = nullptr;  // setContactTimer
 };
