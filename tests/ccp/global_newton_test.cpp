@@ -193,6 +193,17 @@ TEST(GlobalNewton, TheSiconosBoxStackConvergesInFewSweeps) {
   EXPECT_LE(test::relativeResidual(problem.delassus, gamma, problem.r, problem.mu, true), 1e-8);
 }
 
+TEST(GlobalNewton, ProblemsAboveTheContactLimitTakeNoGlobalSteps) {
+  NsgsSettings settings;
+  settings.global_newton_max_contacts = 3;  // the box has 4
+  settings.max_iterations = 200;
+  NsgsSolver solver(settings);
+  Eigen::VectorXd gamma;
+  const Result result = solver.solve(boxOnIncline(0.1).dense, gamma);
+  EXPECT_EQ(result.global_newton_tries, 0);
+  EXPECT_GT(result.iterations, 2 * settings.global_newton_interval);
+}
+
 TEST(GlobalNewton, RefusesABadStepLimitByName) {
   NsgsSettings settings;
   settings.global_newton_step_limit = 0.0;

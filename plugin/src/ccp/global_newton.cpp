@@ -106,8 +106,8 @@ void GlobalNewtonWorkspace::prepare(const Problem& problem) {
 }
 
 double globalNewton(const Problem& problem, const Eigen::VectorXd& gamma, int iterations,
-                    double step_limit, double tolerance, double rho, GlobalNewtonWorkspace& ws,
-                    Workspace& base, Eigen::VectorXd& candidate) {
+                    double step_limit, double tolerance, double rho, const Deadline& deadline,
+                    GlobalNewtonWorkspace& ws, Workspace& base, Eigen::VectorXd& candidate) {
   if (!ws.prepared) ws.prepare(problem);
   const Eigen::Index nc = problem.numContacts();
   const Eigen::Index n = 3 * nc;
@@ -121,7 +121,7 @@ double globalNewton(const Problem& problem, const Eigen::VectorXd& gamma, int it
   const double start = relativeResidual(gamma, u, problem.r, problem.mu, rho, true, base);
   double best = start;
   Eigen::VectorXd projected(n);
-  for (int k = 0; k < iterations; ++k) {
+  for (int k = 0; k < iterations && !deadline.expired(); ++k) {
     alartCurnier(problem, ws, g, u, phi, &a_blocks, &b_blocks);
     if (phi.squaredNorm() == 0.0) break;
     entries.clear();

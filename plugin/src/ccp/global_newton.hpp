@@ -28,11 +28,12 @@ struct GlobalNewtonWorkspace {
 /// Jacobian J = B + A N by a sparse LU factorisation; its length is limited to `step_limit`
 /// (dimensionless, > 0) times the largest impulse of the iterate. Each iterate is projected
 /// onto the cones and judged by its Coulomb residual (relativeResidual with `rho`, using
-/// `base`'s contact scales); the steps stop early once one is at or below `tolerance`. The best
+/// `base`'s contact scales); the steps stop early once one is at or below `tolerance`, or when
+/// the deadline has expired. The best
 /// one is written to `candidate` and its residual returned when it is lower than gamma's, else
 /// -1 (candidate unspecified): a singular J, or no improvement.
 double globalNewton(const Problem& problem, const Eigen::VectorXd& gamma, int iterations,
-                    double step_limit, double tolerance, double rho, GlobalNewtonWorkspace& ws,
-                    Workspace& base, Eigen::VectorXd& candidate);
+                    double step_limit, double tolerance, double rho, const Deadline& deadline,
+                    GlobalNewtonWorkspace& ws, Workspace& base, Eigen::VectorXd& candidate);
 
 }  // namespace rheofeed::ccp::detail

@@ -100,6 +100,9 @@ std::string NsgsSettings::validate() const {
   if (global_newton_iterations < 1) {
     return format("global_newton_iterations = %g must be >= 1", global_newton_iterations);
   }
+  if (global_newton_max_contacts < 0) {
+    return format("global_newton_max_contacts = %g must be >= 0", global_newton_max_contacts);
+  }
   if (!(global_newton_step_limit > 0.0) || !std::isfinite(global_newton_step_limit)) {
     return format("global_newton_step_limit = %g must be finite and > 0", global_newton_step_limit);
   }
@@ -267,9 +270,9 @@ struct NsgsRun {
   // only when they lower the Coulomb residual; returns the residual of the gamma kept.
   double globalNewtonSteps(double current) {
     ++result.global_newton_tries;
-    const double found = detail::globalNewton(problem, gamma, settings.global_newton_iterations,
-                                              settings.global_newton_step_limit, settings.tolerance,
-                                              settings.residual_rho, newton, ws, candidate);
+    const double found = detail::globalNewton(
+        problem, gamma, settings.global_newton_iterations, settings.global_newton_step_limit,
+        settings.tolerance, settings.residual_rho, deadline, newton, ws, candidate);
     if (found < 0.0) {
       newton_wait *= 2;  // back off: each failed attempt costs many sweeps' worth
       return current;
@@ -299,7 +302,9 @@ struct NsgsRun {
       arrangeOrder(k);
       sweep();
       result.iterations = k;
-      const bool global = settings.global_newton_interval > 0 && k == next_newton;
+      const bool global = settings.global_newton_interval > 0 &&
+                          problem.numContacts() <= settings.global_newton_max_contacts &&
+                          k == next_newton;
       if (global) next_newton += newton_wait;
       const bool refresh = global || k % settings.refresh_interval == 0;
       double current = refresh ? exactResidual() : residual();

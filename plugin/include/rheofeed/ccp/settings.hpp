@@ -161,6 +161,10 @@ struct NsgsSettings {
   int global_newton_interval = 50;
   /// Newton steps of one global attempt (>= 1).
   int global_newton_iterations = 40;
+  /// Problems with more contacts than this (>= 0) take no global Newton steps: the sparse LU
+  /// factorisation's fill-in grows with the pile (measured: one attempt on the stability
+  /// matrix's 1000-box bin, 4160 contacts, took 61 s, against 1-2 s on the main demo's 300-400).
+  int global_newton_max_contacts = 1000;
   /// Longest global Newton step, as a share of the largest impulse of the iterate
   /// (dimensionless, finite, > 0): near a solution the Jacobian's nearly singular directions can
   /// ask for internal impulses far outside the cones.
