@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
   double duration = 5.0;
   std::string solver = "nsgs";
   bool groups = false;
-  int sweeps = 0, global_newton = 0, newton_iterations = 0;
+  int sweeps = 0, global_newton = -1, newton_iterations = 0;
   double omega = 1.0, proximal = 0.0, step_limit = 0.0;
   std::string csv_path, dump_dir;
   app.add_option("--scene", scene_name, "scene name in demos/scenes or a scene file");
@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
   app.add_option("--sweeps", sweeps, "NSGS sweep budget (0: the world's default)")
       ->check(CLI::Range(0, 100000000));
   app.add_option("--global-newton", global_newton,
-                 "NSGS: global Newton steps every N sweeps (0: never)")
+                 "NSGS: global Newton steps every N sweeps (0: never; default: the world's)")
       ->check(CLI::Range(0, 1000000));
   app.add_option("--newton-iterations", newton_iterations,
                  "NSGS: Newton steps per global attempt (0: the default)")
@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
       if (sweeps > 0) s.nsgs.max_iterations = sweeps;
       s.nsgs.omega = omega;
       s.nsgs.proximal_weight = proximal;
-      s.nsgs.global_newton_interval = global_newton;
+      if (global_newton >= 0) s.nsgs.global_newton_interval = global_newton;
       if (newton_iterations > 0) s.nsgs.global_newton_iterations = newton_iterations;
       if (step_limit > 0) s.nsgs.global_newton_step_limit = step_limit;
     };
