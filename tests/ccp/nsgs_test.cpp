@@ -22,8 +22,9 @@ namespace {
 
 // Required Coulomb residual (the solver's scale-invariant definition, recomputed here).
 constexpr double kTolerance = 1e-8;
-// Sweep budget: the 13-box stack (BoxesStack1) takes about 2.6e5 sweeps (2.4 s at -O3), the
-// slowest of the files; the budget leaves a 4x margin.
+// Sweep budget: with sweeps alone (NsgsSettings::global_newton_interval = 0) the 13-box stack
+// (BoxesStack1) takes about 2.6e5 sweeps, the slowest of the files; the budget leaves a 4x
+// margin for that (the default, with global Newton steps, takes 512).
 constexpr int kMaxSweeps = 1'000'000;
 // Membership of the returned impulses in K: projections round at the ulp level of gamma.
 constexpr double kConeRoundoff = 1e-12;

@@ -21,6 +21,7 @@
 #include "rheofeed/ccp/nsgs.hpp"
 
 #include "contact_velocity.hpp"
+#include "global_newton.hpp"
 #include "local_coulomb.hpp"
 #include "rheofeed/ccp/cone.hpp"
 #include "solver_internal.hpp"
@@ -93,6 +94,18 @@ std::string NsgsSettings::validate() const {
     return format("local_tolerance = %g must be finite and > 0", local_tolerance);
   }
   if (refresh_interval < 1) return format("refresh_interval = %g must be >= 1", refresh_interval);
+  if (global_newton_interval < 0) {
+    return format("global_newton_interval = %g must be >= 0", global_newton_interval);
+  }
+  if (global_newton_iterations < 1) {
+    return format("global_newton_iterations = %g must be >= 1", global_newton_iterations);
+  }
+  if (global_newton_max_contacts < 0) {
+    return format("global_newton_max_contacts = %g must be >= 0", global_newton_max_contacts);
+  }
+  if (!(global_newton_step_limit > 0.0) || !std::isfinite(global_newton_step_limit)) {
+    return format("global_newton_step_limit = %g must be finite and > 0", global_newton_step_limit);
+  }
   if (!(time_limit_s >= 0.0)) return format("time_limit_s = %g must be >= 0", time_limit_s);
   return {};
 }
@@ -105,6 +118,8 @@ struct NsgsSolver::Workspace {
   // Groups of contacts solved together (contactGroups), and their coupled blocks of N.
   std::vector<std::vector<Eigen::Index>> groups;
   std::vector<detail::GroupMatrix> group_blocks;
+  detail::GlobalNewtonWorkspace newton;  // the global Newton steps' sparse N
+  Eigen::VectorXd candidate;             // the global Newton steps' result
 };
 
 NsgsSolver::NsgsSolver() = default;
@@ -128,9 +143,13 @@ struct NsgsRun {
   Eigen::VectorXd& best;
   const std::vector<std::vector<Eigen::Index>>& groups;
   const std::vector<detail::GroupMatrix>& group_blocks;
+  detail::GlobalNewtonWorkspace& newton;
+  Eigen::VectorXd& candidate;
   Contacts& contacts;
   Result& result;
   std::mt19937 random{kShuffleSeed};
+  int newton_wait = settings.global_newton_interval;  // sweeps between global Newton attempts
+  int next_newton = settings.global_newton_interval;  // sweep of the next attempt
 
   // Coulomb residual of gamma with the maintained velocities (ws.u filled first).
   double residual() {
@@ -247,6 +266,28 @@ struct NsgsRun {
     }
   }
 
+  // Global Newton steps from gamma (residual `current`, maintained velocities exact), kept
+  // only when they lower the Coulomb residual; returns the residual of the gamma kept.
+  double globalNewtonSteps(double current) {
+    ++result.global_newton_tries;
+    const double found = detail::globalNewton(
+        problem, gamma, settings.global_newton_iterations, settings.global_newton_step_limit,
+        settings.tolerance, settings.residual_rho, deadline, newton, ws, candidate);
+    if (found < 0.0) {
+      newton_wait *= 2;  // back off: each failed attempt costs many sweeps' worth
+      return current;
+    }
+    candidate.swap(gamma);
+    const double trial = exactResidual();
+    if (trial < current) {
+      ++result.global_newton_kept;
+      return trial;
+    }
+    candidate.swap(gamma);
+    contacts.refresh(gamma);
+    return current;
+  }
+
   // The sweeps; returns the status.
   Status iterate() {
     double best_residual = exactResidual();
@@ -261,8 +302,16 @@ struct NsgsRun {
       arrangeOrder(k);
       sweep();
       result.iterations = k;
-      const bool refresh = k % settings.refresh_interval == 0;
+      const bool global = settings.global_newton_interval > 0 &&
+                          problem.numContacts() <= settings.global_newton_max_contacts &&
+                          k == next_newton;
+      if (global) next_newton += newton_wait;
+      const bool refresh = global || k % settings.refresh_interval == 0;
       double current = refresh ? exactResidual() : residual();
+      if (global && current > settings.tolerance && std::isfinite(current)) {
+        current = globalNewtonSteps(current);
+        next_newton = k + newton_wait;
+      }
       if (!std::isfinite(current)) {
         result.message = "NSGS: non-finite residual (impulses or velocities overflowed)";
         gamma = best;
@@ -292,8 +341,8 @@ Status runSweeps(const Problem& problem, const NsgsSettings& settings,
                  const detail::Deadline& deadline, Eigen::VectorXd& gamma, Workspace& w,
                  Result& result) {
   Contacts contacts(problem, problem.r, w.base);
-  NsgsRun<Contacts> run{problem, settings, deadline, gamma,          w.base,   w.blocks,
-                        w.order, w.best,   w.groups, w.group_blocks, contacts, result};
+  NsgsRun<Contacts> run{problem, settings, deadline,       gamma,    w.base,      w.blocks, w.order,
+                        w.best,  w.groups, w.group_blocks, w.newton, w.candidate, contacts, result};
   return run.iterate();
 }
 
@@ -420,6 +469,7 @@ Result NsgsSolver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
   w.order.resize(w.groups.size());
   for (std::size_t g = 0; g < w.groups.size(); ++g) w.order[g] = static_cast<Eigen::Index>(g);
   w.best.resize(problem.size());
+  w.newton.prepared = false;
   if (settings_.warm_start && gamma.size() == problem.size() && gamma.allFinite()) {
     detail::projectOntoCones(gamma, problem.mu);
   } else {

@@ -19,7 +19,8 @@ using reference::BodyId;
 
 class ReferenceSimulation final : public PartSimulation {
  public:
-  ReferenceSimulation(const Scene& scene, Method method, reference::StepObserver observer)
+  ReferenceSimulation(const Scene& scene, Method method, reference::StepObserver observer,
+                      const ReferenceSettingsAdjust& adjust = {})
       : PartSimulation(scene, method) {
     reference::Settings s;
     s.gravity = scene.gravity;
@@ -34,6 +35,7 @@ class ReferenceSimulation final : public PartSimulation {
     s.solver.coulomb_outer_iterations = scene.solver.coulomb_iterations;
     s.max_correcting_velocity = scene.solver.max_correcting_velocity;
     s.surface_layer = scene.solver.surface_layer;
+    if (adjust) adjust(s);
     world_ = std::make_unique<reference::World>(s);
     world_->setStepObserver(std::move(observer));
 
@@ -169,7 +171,8 @@ class ReferenceSimulation final : public PartSimulation {
     for (const reference::ContactImpulse& c : world_->contacts()) {
       const bool f1 = isFixture(c.g1), f2 = isFixture(c.g2);
       if (f1 == f2) continue;
-      out.push_back(f1 ? FixtureContact{c.g2, c.g1, -c.normal} : FixtureContact{c.g1, c.g2, c.normal});
+      out.push_back(f1 ? FixtureContact{c.g2, c.g1, -c.normal}
+                       : FixtureContact{c.g1, c.g2, c.normal});
     }
     return out;
   }
@@ -206,13 +209,19 @@ std::unique_ptr<Simulation> makeReferenceSimulation(const Scene& scene, Method m
 
 std::unique_ptr<Simulation> makeObservedReferenceSimulation(const Scene& scene, Method method,
                                                             reference::StepObserver observer) {
+  return makeObservedReferenceSimulation(scene, method, std::move(observer), {});
+}
+
+std::unique_ptr<Simulation> makeObservedReferenceSimulation(const Scene& scene, Method method,
+                                                            reference::StepObserver observer,
+                                                            const ReferenceSettingsAdjust& adjust) {
   if (method != Method::ReferenceRheonomic && method != Method::ReferenceFullVibration) {
     throw std::invalid_argument(
         "makeObservedReferenceSimulation: method " + std::string(toString(method)) +
         " is not a reference method (reference_rheonomic, reference_full_vibration)");
   }
   scene.validate();
-  return std::make_unique<ReferenceSimulation>(scene, method, std::move(observer));
+  return std::make_unique<ReferenceSimulation>(scene, method, std::move(observer), adjust);
 }
 
 }  // namespace rheofeed::scene

@@ -18,6 +18,11 @@
 /// contacts of one pair of bodies are solved together (NsgsSettings::group_contacts). Matrix-free
 /// problems are swept through the generalised velocity `M^-1 D gamma`, touching only the
 /// columns of the contact's bodies, so thousands of contacts cost O(nnz(D)) per sweep.
+/// Every NsgsSettings::global_newton_interval sweeps, semismooth Newton steps on all contacts at
+/// once (global_newton.cpp, a sparse LU factorisation) redistribute impulses along the nearly
+/// singular directions of N (a box's coplanar corners, rank deficient up to the compliance),
+/// which the sweeps correct only at the compliance's pace; they are kept only when they lower the
+/// Coulomb residual.
 ///
 /// Stopping test: the Coulomb residual of solver.hpp (Result::coulomb_distance: dimensionless
 /// natural map with De Saxce's velocity, invariant to the units of N and r), recomputed from
