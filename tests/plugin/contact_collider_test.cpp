@@ -247,11 +247,15 @@ TEST(ContactCollider, SpeculativeContactsStopASphereAtAThinWall) {
 }
 
 TEST(ContactCollider, RefusesANonPositiveSpeculativeFraction) {
+  dInitODE2(0);
+  dWorldID world = dWorldCreate();
+  FeederSet feeders;
   for (double bad : {0.0, -1.0, double(NAN), double(INFINITY)}) {
     ContactCollider::Settings s;
     s.speculative_fraction = bad;
-    EXPECT_THROW(OdeWorld({}, s), std::invalid_argument) << bad;
+    EXPECT_THROW(ContactCollider(world, feeders, s), std::invalid_argument) << bad;
   }
+  dWorldDestroy(world);
 }
 
 }  // namespace speculative
