@@ -2,11 +2,10 @@
 // Stage timing (simulation.hpp, StageTimes): off by default; when on it counts the steps, the
 // contact joints and their constraint rows by ODE's rule for a contact joint (1 normal row, plus
 // 2 friction rows when mu > 0: dxJointContact::getInfo1 of ODE 0.16) and the reference's cone
-// (3 rows); it does not change a run. No test reads a time for its size: times are only
-// required to be finite and non-negative, and exactly zero where the stage does not exist.
+// (3 rows); it does not change a run. No test reads a time: the times are the benchmark's
+// (crowd_scale_bench); here only the counts are checked.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <memory>
 
 #include "common/builtin_scenes.hpp"
@@ -23,22 +22,11 @@ Scene cubeOnFloor(double mu, int steps) {
   return s;
 }
 
-void expectValidTimes(const StageTimes& t) {
-  for (double seconds : {t.collision, t.contacts, t.solve, t.checks}) {
-    EXPECT_TRUE(std::isfinite(seconds));
-    EXPECT_GE(seconds, 0.0);
-  }
-}
-
 TEST(StageTiming, IsOffByDefaultAndCountsNothing) {
   const auto sim = makeSimulation(cubeOnFloor(0.5, 10), Method::OdeRheonomic);
   for (int k = 0; k < 10; ++k) sim->step();
   const StageTimes& t = sim->stageTimes();
   EXPECT_EQ(t.steps, 0);
-  EXPECT_EQ(t.collision, 0.0);
-  EXPECT_EQ(t.contacts, 0.0);
-  EXPECT_EQ(t.solve, 0.0);
-  EXPECT_EQ(t.checks, 0.0);
   EXPECT_EQ(t.contact_count, 0);
   EXPECT_EQ(t.constraint_rows, 0);
 }
@@ -63,11 +51,10 @@ TEST(StageTiming, CountsTheTimedStepsAndTheContactRowsOfOdeJoints) {
     EXPECT_GT(contacts, 0) << "the cube rests on the floor";
     EXPECT_EQ(t.contact_count, contacts) << "mu = " << mu;
     EXPECT_EQ(t.constraint_rows, (mu > 0 ? 3 : 1) * contacts) << "mu = " << mu;
-    expectValidTimes(t);
   }
 }
 
-// The reference engine does not split its step: collision and contact creation stay zero.
+// The reference engine does not split its step (its whole step is timed as the solve).
 TEST(StageTiming, ReferenceEngineTimesItsWholeStepAsTheSolveWithThreeRowsPerContact) {
   const auto sim = makeSimulation(cubeOnFloor(0.5, 10), Method::ReferenceRheonomic);
   sim->setStageTiming(true);
@@ -78,12 +65,9 @@ TEST(StageTiming, ReferenceEngineTimesItsWholeStepAsTheSolveWithThreeRowsPerCont
   }
   const StageTimes& t = sim->stageTimes();
   EXPECT_EQ(t.steps, 10);
-  EXPECT_EQ(t.collision, 0.0);
-  EXPECT_EQ(t.contacts, 0.0);
   EXPECT_GT(contacts, 0);
   EXPECT_EQ(t.contact_count, contacts);
   EXPECT_EQ(t.constraint_rows, 3 * contacts);
-  expectValidTimes(t);
 }
 
 // Timing only reads clocks: a timed run of the hopper-fed trough (parts in a heap, many pairs)
@@ -111,7 +95,6 @@ TEST(StageTiming, DoesNotChangeTheRun) {
   }
   EXPECT_EQ(timed->stageTimes().steps, 150);
   EXPECT_GT(timed->stageTimes().contact_count, 0);
-  expectValidTimes(timed->stageTimes());
 }
 
 }  // namespace
