@@ -145,7 +145,8 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
 
 void ContactCollider::addContacts(dGeomID o1, dGeomID o2, dContact* contacts, int n,
                                   const double* gap_speed) {
-  const StageClock creation(contact_seconds_);  // contact creation, speculative too (setContactTimer)
+  const StageClock creation(
+      contact_seconds_);  // contact creation, speculative too (setContactTimer)
   for (int i = 0; i < n; ++i) contacts[i].surface = settings_.default_surface;
   if (surface_ && !surface_(o1, o2, contacts, n)) return;
   if (gap_speed) {
@@ -250,8 +251,8 @@ int leadingPoints(dGeomID g, const dReal dir[3], dReal out[8][3]) {
       dGeomBoxGetLengths(g, l);
       int n = 0;
       for (int i = 0; i < 8; ++i) {
-        local((i & 1 ? 0.5 : -0.5) * l[0], (i & 2 ? 0.5 : -0.5) * l[1],
-              (i & 4 ? 0.5 : -0.5) * l[2], out[n++]);
+        local((i & 1 ? 0.5 : -0.5) * l[0], (i & 2 ? 0.5 : -0.5) * l[1], (i & 4 ? 0.5 : -0.5) * l[2],
+              out[n++]);
       }
       return n;
     }
@@ -290,7 +291,8 @@ int leadingPoints(dGeomID g, const dReal dir[3], dReal out[8][3]) {
         const double h = (e ? 0.5 : -0.5) * len;
         for (int q = 0; q < 4; ++q) {
           const double cu = q == 0 ? 1 : q == 2 ? -1 : 0, cw = q == 1 ? 1 : q == 3 ? -1 : 0;
-          for (int k = 0; k < 3; ++k) out[n][k] = c[k] + h * axis[k] + rad * (cu * u[k] + cw * w[k]);
+          for (int k = 0; k < 3; ++k)
+            out[n][k] = c[k] + h * axis[k] + rad * (cu * u[k] + cw * w[k]);
           ++n;
         }
       }
@@ -331,8 +333,7 @@ void ContactCollider::placeSweeps(dSpaceID space, double step) {
       dWorldGetGravity(world_, gravity);
       for (int k = 0; k < 3; ++k) end_v[k] += gravity[k] * step;
     }
-    const double speed =
-        std::sqrt(end_v[0] * end_v[0] + end_v[1] * end_v[1] + end_v[2] * end_v[2]);
+    const double speed = std::sqrt(end_v[0] * end_v[0] + end_v[1] * end_v[1] + end_v[2] * end_v[2]);
     const double travel = speed * step;
     if (!(travel > settings_.speculative_fraction * smallestHalfExtent(g))) continue;
 
@@ -352,8 +353,7 @@ void ContactCollider::placeSweeps(dSpaceID space, double step) {
     if (sweeps_.size() == proxies_.size()) proxies_.push_back(dCreateBox(nullptr, 1, 1, 1));
     s.proxy = proxies_[sweeps_.size()];
     dGeomBoxSetLengths(s.proxy, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-    dGeomSetPosition(s.proxy, 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]),
-                     0.5 * (lo[2] + hi[2]));
+    dGeomSetPosition(s.proxy, 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]));
     dSpaceAdd(space, s.proxy);
     sweep_of_proxy_[s.proxy] = sweeps_.size();
     sweeps_.push_back(std::move(s));
@@ -390,7 +390,8 @@ void ContactCollider::castSweeps(double step) {
         if (dCollide(ray_, other, 1, &hit, sizeof hit) < 1) continue;
         double along =
             hit.normal[0] * s.dir[0] + hit.normal[1] * s.dir[1] + hit.normal[2] * s.dir[2];
-        const double sign = along > 0 ? -1.0 : 1.0;  // the normal out of `other`, against the motion
+        const double sign =
+            along > 0 ? -1.0 : 1.0;  // the normal out of `other`, against the motion
         along = std::fabs(along);
         if (!(along > 1e-6)) continue;  // grazing: the motion does not close it
         dContactGeom& c = contacts[static_cast<std::size_t>(n)].geom;

@@ -291,15 +291,16 @@ TEST(SceneLimits, AngleBeyondAMillionDegreesIsRefusedWithItsRange) {
 }
 
 TEST(SceneLimits, GeomRotationAngleBeyondTheRangeIsRefused) {
-  refused(replaced(kGood, R"("position": [0, 1, -0.01]})",
-                   R"("position": [0, 1, -0.01], "rotation": {"axis": [0, 0, 1], "angle_deg": -2e6}})"),
-          "fixtures[1].geoms[0].rotation.angle_deg", {"-2000000", "degrees"});
+  refused(
+      replaced(kGood, R"("position": [0, 1, -0.01]})",
+               R"("position": [0, 1, -0.01], "rotation": {"axis": [0, 0, 1], "angle_deg": -2e6}})"),
+      "fixtures[1].geoms[0].rotation.angle_deg", {"-2000000", "degrees"});
 }
 
 TEST(SceneLimits, RemovalHeightAboveEverySpawnPointIsRefused) {
   // The highest spawn point: parts[1] at z = 0.005 m.
-  refused(replaced(kGood, R"("removal_height": -1)", R"("removal_height": 0.01)"),
-          "removal_height", {"0.01", "above every spawn point", "z = 0.005 m"});
+  refused(replaced(kGood, R"("removal_height": -1)", R"("removal_height": 0.01)"), "removal_height",
+          {"0.01", "above every spawn point", "z = 0.005 m"});
   // Above one family's region only: accepted (the scene check warns, spawn_below_removal).
   EXPECT_NO_THROW(
       parseScene(replaced(kGood, R"("removal_height": -1)", R"("removal_height": 0.004)"), "ok"));

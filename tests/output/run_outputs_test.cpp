@@ -100,11 +100,10 @@ TEST(SeriesCsv, OneRowPerSampleReadsBackAsTheSeries) {
   const RunMetrics r = run();
   const auto rows = csvRows(seriesCsv(r));
   ASSERT_EQ(rows.size(), 3u);
-  EXPECT_EQ(rows[0], (std::vector<std::string>{"time_s", "parts", "mean_velocity_mps", "ci95_mps",
-                                               "mean_height_m", "exited", "lost_fell",
-                                               "lost_through_fixture", "lost_out_of_bounds",
-                                               "lost_nonfinite", "lost_too_fast",
-                                               "lost_left_feeder"}));
+  EXPECT_EQ(rows[0], (std::vector<std::string>{
+                         "time_s", "parts", "mean_velocity_mps", "ci95_mps", "mean_height_m",
+                         "exited", "lost_fell", "lost_through_fixture", "lost_out_of_bounds",
+                         "lost_nonfinite", "lost_too_fast", "lost_left_feeder"}));
   for (std::size_t k = 0; k < r.series.size(); ++k) {
     const DriftSample& d = r.series[k];
     const auto& row = rows[k + 1];

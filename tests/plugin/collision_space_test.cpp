@@ -59,7 +59,7 @@ TEST(CollisionSpace, ReportsEveryWallContactOfTheCrowdedTrough) {
   dInitODE2(0);
   dSpaceID space = createCollisionSpace(nullptr);
   const Counts counts = sweepWallFace(space);
-  dSpaceDestroy(space);  // destroys its geoms (cleanup mode on)
+  dSpaceDestroy(space);                // destroys its geoms (cleanup mode on)
   EXPECT_EQ(counts.touching, 13 * 9);  // the grid lies 2 mm inside the wall: all touch
   EXPECT_EQ(counts.missed, 0);
 }

@@ -172,7 +172,6 @@ TEST(ContactColliderJoints, ConnectedBodiesDoNotCollide) {
   EXPECT_GT(w.collider->contactCount(), 0);
 }
 
-
 // Speculative contacts (contact_collider.hpp): a 20 mm cube falling at 3 m/s onto a 2 mm plate
 // moves 30 mm per step of 10 ms, more than cube and plate together: ODE's contacts, made only
 // where geoms overlap, never see the plate. Swept, the cube lands on it: at rest on its top,

@@ -425,8 +425,8 @@ TriangleMesh triangleSoup() {
 }
 
 TEST(SceneCheck, MeshWallThicknessEqualsTheAllPairsTestExactly) {
-  const TriangleMesh bowl = loadTriangleMesh(
-      std::filesystem::path(RHEOFEED_DEMO_DIR) / "meshes" / "vibratory_bowl.stl");
+  const TriangleMesh bowl =
+      loadTriangleMesh(std::filesystem::path(RHEOFEED_DEMO_DIR) / "meshes" / "vibratory_bowl.stl");
   const TriangleMesh shell = testing::sphericalShell(0.1, 0.09, 24, 12);
   const TriangleMesh soup = triangleSoup();
   for (const TriangleMesh* m : {&bowl, &shell, &soup}) {

@@ -138,9 +138,10 @@ TEST(LeftTheFeeder, CubesRunningOffTheBeltsEndWithoutAnExitAreCounted) {
 }
 
 // The turntable: a disc of radius 0.4 m (top z = 0) turning at 50 rad/s about z, a
-// static rim of 16 boxes 2 cm thick and 4 cm tall closing at r = 0.41 m, a catch floor 0.3 m below. 20 cubes of 2 cm
-// dropped at r = 0.1-0.3 m: their surface speed is 5-15 m/s, far beyond what a 4 cm rim holds
-// back. Independent count: cubes whose centre is beyond the rim (r > 0.42 m) or below the disc.
+// static rim of 16 boxes 2 cm thick and 4 cm tall closing at r = 0.41 m, a catch floor 0.3 m below.
+// 20 cubes of 2 cm dropped at r = 0.1-0.3 m: their surface speed is 5-15 m/s, far beyond what a 4
+// cm rim holds back. Independent count: cubes whose centre is beyond the rim (r > 0.42 m) or below
+// the disc.
 Scene fastTurntableScene() {
   Scene s;
   s.name = "fast_turntable";
@@ -184,8 +185,7 @@ TEST(LeftTheFeeder, FastTurntableFlingsCubesOverItsRimAndEveryOneIsCounted) {
     }
     const RunHealth& h = sim->health();
     EXPECT_GT(off, 0);
-    EXPECT_EQ(h.parts_left_feeder + h.parts_through_fixture + h.parts_fell +
-                  h.parts_out_of_bounds,
+    EXPECT_EQ(h.parts_left_feeder + h.parts_through_fixture + h.parts_fell + h.parts_out_of_bounds,
               off);
   }
 }
@@ -231,7 +231,7 @@ TEST(LeftTheFeeder, CubeFallingThroughAGapOntoAFloorUnderTheFeederIsCounted) {
     const std::unique_ptr<Simulation> sim = runFor(s, m, 1.5);
     const PartState p = sim->part(0);
     EXPECT_LT(p.position.z, -0.2);  // on the floor, under the feeder (its plates end at
-    EXPECT_GT(p.position.x, -0.5);   // x = -0.5 and 0.53 m)
+    EXPECT_GT(p.position.x, -0.5);  // x = -0.5 and 0.53 m)
     EXPECT_LT(p.position.x, 0.53);
     EXPECT_EQ(sim->health().parts_left_feeder, 1);
     EXPECT_EQ(sim->health().partsLost(), 1);
@@ -246,7 +246,8 @@ TEST(PhysicalSpeed, BoundIsTheCasesEnergyBudgetWithItsMargin) {
   SceneLimits l;
   l.surface_speed = 0.3;
   l.correcting_speed = 0.5;
-  const double expected = (1.5 * (1 + std::sqrt(2 * kGravity * 0.15)) + 1.5 * 0.3 + 0.5) * 1.25 + 0.1;
+  const double expected =
+      (1.5 * (1 + std::sqrt(2 * kGravity * 0.15)) + 1.5 * 0.3 + 0.5) * 1.25 + 0.1;
   EXPECT_NEAR(partPhysicalSpeedBound(l, 0.5, kGravity, 1.0, 0.2, 0.05), expected, 1e-12);
   // Above the highest spawn point a part has no fall to spend.
   EXPECT_NEAR(partPhysicalSpeedBound(l, 0.5, kGravity, 1.0, 0.2, 0.3),
@@ -293,7 +294,8 @@ int partsOverTheirBound(const Scene& s, Method m, double seconds, RunHealth* hea
           kPhysicalSpeedFactor *
               ((1 + s.material.restitution) *
                    (v0 + std::sqrt(2 * kGravity * std::max(0.0, top - p.position.z))) +
-               (1 + s.material.restitution) * limits.surface_speed + s.solver.max_correcting_velocity) +
+               (1 + s.material.restitution) * limits.surface_speed +
+               s.solver.max_correcting_velocity) +
           kPhysicalSpeedMargin;
       if (energySpeed(p, pi.mass, pi.inertia) > bound) over[static_cast<std::size_t>(i)] = true;
     }

@@ -813,8 +813,8 @@ TEST_P(Bowl, AngularDriftMatchesReferenceFullVibration) {
   // ODE full vibration against the same judge: with the friction cone of the patched ODE
   // (issue 15: within 2 %) and, for the record, with ODE's pyramid (+15 % before the cone).
   if (!odeHasFrictionCone()) return;
-  const Drift cone = fullVibration(u, scene::Method::OdeFullVibration, kJudgeStepsPerCycle,
-                                   FrictionModel::Cone);
+  const Drift cone =
+      fullVibration(u, scene::Method::OdeFullVibration, kJudgeStepsPerCycle, FrictionModel::Cone);
   const Drift pyramid = fullVibration(u, scene::Method::OdeFullVibration, kJudgeStepsPerCycle,
                                       FrictionModel::Pyramid);
   std::printf(

@@ -153,7 +153,8 @@ void checkAngle(const std::string& path, double angle, double max, const char* u
   if (!(std::abs(angle) <= max)) {
     fail(path, "must be in [-" + show(max) + ", " + show(max) + "] " + unit +
                    " (1e6 degrees: a double resolves no finer angle there than 1e-10 degree), "
-                   "got " + show(angle));
+                   "got " +
+                   show(angle));
   }
 }
 

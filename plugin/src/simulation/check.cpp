@@ -100,8 +100,8 @@ void measureFixtures(CheckContext& c) {
       }
       const Thickness t = fixtureThickness(gm.shape);
       if (!t.measured) {
-        c.skipped.push_back({geomPath(f, k), gm.shape.mesh_data->triangles.size() / 3,
-                             t.ray_tests});
+        c.skipped.push_back(
+            {geomPath(f, k), gm.shape.mesh_data->triangles.size() / 3, t.ray_tests});
       }
       if (t.value < c.thinnest_fixture) {
         c.thinnest_fixture = t.value;

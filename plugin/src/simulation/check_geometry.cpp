@@ -26,7 +26,6 @@ std::string geomPath(std::size_t f, std::size_t g) {
   return idx("fixtures", f) + "." + idx("geoms", g);
 }
 
-
 // Bounding box of a fixture geom at its pose (the scene limits' computation); a plane or a mesh
 // not loaded is unbounded.
 Box3 geomBounds(const Fixture::Geom& g) {
@@ -49,7 +48,6 @@ double maxAlong(const Box3& b, const Vec3& up) {
 double minAlong(const Box3& b, const Vec3& up) {
   return -maxAlong(b, -up);
 }
-
 
 // Smallest extent of a mesh's bounding box in its own frame, times `scale` (m).
 double meshBoxExtent(const TriangleMesh& mesh, double scale) {
@@ -250,6 +248,5 @@ double radiusFromAxis(const Box3& b, const Vec3& origin, const Vec3& axis) {
   }
   return r;
 }
-
 
 }  // namespace rheofeed::scene::checks

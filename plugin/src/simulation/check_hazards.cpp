@@ -105,8 +105,9 @@ void checkTunnelling(const CheckContext& c, std::vector<Hazard>& out) {
       << ")" << c.part_note << ": " << mm(allowed) << "; parts can pass through";
     hz.message = m.str();
     // Largest h with h (v + g h) <= allowed.
-    const double safe_h =
-        c.g > 0 ? (-speed + std::sqrt(speed * speed + 4 * c.g * allowed)) / (2 * c.g) : allowed / speed;
+    const double safe_h = c.g > 0
+                              ? (-speed + std::sqrt(speed * speed + 4 * c.g * allowed)) / (2 * c.g)
+                              : allowed / speed;
     std::ostringstream s;
     s << c.step_field << " <= " << fmt(safe_h) << " s";
     if (fixture_thinner) {
@@ -178,8 +179,8 @@ void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out) {
       const double x = c.light_thickness / (c.g * c.h * c.h);
       std::ostringstream m;
       m << "the heaviest part (" << idx("parts", c.heavy_family) << ", " << fmt(c.heaviest)
-        << " kg) is " << fmt(ratio) << " times the lightest (" << idx("parts", c.light_family) << ", "
-        << fmt(c.lightest) << " kg, " << mm(c.light_thickness) << " thick); "
+        << " kg) is " << fmt(ratio) << " times the lightest (" << idx("parts", c.light_family)
+        << ", " << fmt(c.lightest) << " kg, " << mm(c.light_thickness) << " thick); "
         << (quickstep ? "ODE quickstep" : "the reference solver") << " with " << k
         << " iterations at h = " << fmt(c.h) << " s (thickness / (g h^2) = " << fmt(x)
         << (limit < 1 ? ") is below the measured range, where even stacks of equal parts sank "
@@ -198,8 +199,9 @@ void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out) {
       if (need) s << "solver.iterations >= " << need << ", or ";
       double safe_h = c.h;
       for (int n = 0;
-           n < 60 && ratio > (quickstep ? odeQuickstepMassRatioLimit(k, c.light_thickness, safe_h, c.g)
-                                        : referenceMassRatioLimit(k, c.light_thickness, safe_h, c.g));
+           n < 60 &&
+           ratio > (quickstep ? odeQuickstepMassRatioLimit(k, c.light_thickness, safe_h, c.g)
+                              : referenceMassRatioLimit(k, c.light_thickness, safe_h, c.g));
            ++n) {
         safe_h *= 0.8;
       }
@@ -305,8 +307,7 @@ void checkWeakCollider(const CheckContext& c, std::size_t part, std::vector<Haza
   }
 }
 
-void checkSpawnInsideFixture(const CheckContext& c, std::size_t part,
-                             std::vector<Hazard>& out) {
+void checkSpawnInsideFixture(const CheckContext& c, std::size_t part, std::vector<Hazard>& out) {
   const std::size_t i = part;
   const PartSpec& p = c.scene.parts[i];
   for (const GeomInfo& gi : c.geoms) {
@@ -314,8 +315,8 @@ void checkSpawnInsideFixture(const CheckContext& c, std::size_t part,
     if (!regionInsideGeom(p.spawn_min, p.spawn_max, gm)) continue;
     Hazard hz;
     hz.kind = Hazard::Kind::SpawnInsideFixture;
-    hz.where = idx("parts", i) + ".spawn_min, " + idx("parts", i) + ".spawn_max, " +
-               geomPath(gi.f, gi.g);
+    hz.where =
+        idx("parts", i) + ".spawn_min, " + idx("parts", i) + ".spawn_max, " + geomPath(gi.f, gi.g);
     hz.message = "the spawn region of " + idx("parts", i) + " ('" + p.name + "') reaches into " +
                  geomPath(gi.f, gi.g) + " (" + toString(gm.shape.kind) + ", fixture '" +
                  c.scene.fixtures[gi.f].name +
@@ -356,13 +357,13 @@ void checkSkippedTests(const CheckContext& c, std::vector<Hazard>& out) {
     hz.value = static_cast<double>(s.ray_tests);
     hz.limit = static_cast<double>(kMaxMeshRayTests);
     hz.where = s.path;
-    hz.message = "the wall-thickness test of the mesh " + s.path + " (" +
-                 std::to_string(s.triangles) + " triangles) was skipped after " +
-                 std::to_string(s.ray_tests) + " ray tests (limit " +
-                 std::to_string(kMaxMeshRayTests) +
-                 "): its walls are not counted in the tunnelling check";
-    hz.safe_setting = "a mesh with fewer overlapping triangles (a closed surface without "
-                      "stacked shells), or check the wall thickness by hand";
+    hz.message =
+        "the wall-thickness test of the mesh " + s.path + " (" + std::to_string(s.triangles) +
+        " triangles) was skipped after " + std::to_string(s.ray_tests) + " ray tests (limit " +
+        std::to_string(kMaxMeshRayTests) + "): its walls are not counted in the tunnelling check";
+    hz.safe_setting =
+        "a mesh with fewer overlapping triangles (a closed surface without "
+        "stacked shells), or check the wall thickness by hand";
     out.push_back(hz);
   }
 }

@@ -38,7 +38,8 @@ class TriangleTree {
       : a_(a), b_(b), c_(c), pad_(pad), order_(a.size()) {
     std::iota(order_.begin(), order_.end(), 0);
     centroid_.reserve(a.size());
-    for (std::size_t i = 0; i < a.size(); ++i) centroid_.push_back((1.0 / 3.0) * (a[i] + b[i] + c[i]));
+    for (std::size_t i = 0; i < a.size(); ++i)
+      centroid_.push_back((1.0 / 3.0) * (a[i] + b[i] + c[i]));
     if (!a.empty()) build(0, static_cast<int>(a.size()));
   }
 
@@ -191,8 +192,7 @@ MeshWallThickness meshWallThickness(const TriangleMesh& mesh, double scale, long
     if (!(area2 > 0)) continue;
     const Vec3 dir = (-1.0 / area2) * normal;  // inwards
     const Vec3 origin = (1.0 / 3.0) * (a[i] + b[i] + c[i]);
-    const double nearest =
-        tree.nearest(origin, dir, i, 1e-9 * std::sqrt(area2), result.ray_tests);
+    const double nearest = tree.nearest(origin, dir, i, 1e-9 * std::sqrt(area2), result.ray_tests);
     total_area += 0.5 * area2;
     if (std::isfinite(nearest)) walls.emplace_back(nearest, 0.5 * area2);
     if (result.ray_tests > max_tests) {

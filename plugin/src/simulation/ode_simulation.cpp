@@ -249,7 +249,8 @@ class OdeSimulation final : public PartSimulation {
     for (const ContactCollider::Joint& j : collider_->joints()) {
       const bool f1 = isFixture(j.g1), f2 = isFixture(j.g2);
       if (f1 == f2) continue;  // part-part or fixture-fixture
-      out.push_back(f1 ? FixtureContact{j.g2, j.g1, -j.normal} : FixtureContact{j.g1, j.g2, j.normal});
+      out.push_back(f1 ? FixtureContact{j.g2, j.g1, -j.normal}
+                       : FixtureContact{j.g1, j.g2, j.normal});
     }
     return out;
   }

@@ -328,7 +328,8 @@ PartSimulation::PartSimulation(const Scene& scene, Method method)
   top_spawn_height_ = -kInf;
   for (const PartSpec& p : scene.parts) {  // the highest corner of every spawn region
     for (int c = 0; c < 8; ++c) {
-      const Vec3 corner{c & 1 ? p.spawn_max.x : p.spawn_min.x, c & 2 ? p.spawn_max.y : p.spawn_min.y,
+      const Vec3 corner{c & 1 ? p.spawn_max.x : p.spawn_min.x,
+                        c & 2 ? p.spawn_max.y : p.spawn_min.y,
                         c & 4 ? p.spawn_max.z : p.spawn_min.z};
       top_spawn_height_ = std::max(top_spawn_height_, dot(corner, up_));
     }
@@ -341,8 +342,8 @@ PartSimulation::PartSimulation(const Scene& scene, Method method)
       Footprint fp{geomBounds(geom), 0};
       if (law.kind == FeederLaw::Kind::Vibration && !isEmpty(fp.box)) {
         const Vibration& v = law.vibration;
-        fp.reach = std::abs(v.amplitude) +
-                   std::abs(v.torsion_amplitude) * farthest(fp.box, v.axis_origin);
+        fp.reach =
+            std::abs(v.amplitude) + std::abs(v.torsion_amplitude) * farthest(fp.box, v.axis_origin);
       }
       boxes.push_back(fp);
     }

@@ -145,12 +145,12 @@ class PartSimulation : public Simulation {
   std::unordered_set<dGeomID> fixture_set_;  // lookups only: never iterated
   std::vector<dGeomID> fixture_geoms_;       // in creation order (deterministic iteration)
   std::unordered_map<dGeomID, int> fixture_of_geom_, part_of_geom_;  // lookups only
-  std::vector<std::vector<Footprint>> footprints_;  // per fixture, per geom
-  std::vector<int> feeders_;                        // fixtures with a law
-  Vec3 up_{0, 0, 1};                                // -gravity, unit
+  std::vector<std::vector<Footprint>> footprints_;                   // per fixture, per geom
+  std::vector<int> feeders_;                                         // fixtures with a law
+  Vec3 up_{0, 0, 1};                                                 // -gravity, unit
   double top_spawn_height_ = 0;  // the highest spawn point along up_ (m; physical speed bound)
-  dGeomID ray_ = nullptr;                    // for firstCrossing, in no space
-  std::vector<std::string> reported_;        // kinds already reported on stderr
+  dGeomID ray_ = nullptr;        // for firstCrossing, in no space
+  std::vector<std::string> reported_;  // kinds already reported on stderr
   double time_ = 0;
   long steps_ = 0;
   ContactTotals totals_;

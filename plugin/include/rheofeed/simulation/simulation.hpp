@@ -273,8 +273,9 @@ class Simulation {
   /// the step every active part is checked (RunHealth): a part with a non-finite state, faster
   /// than the scene's speed bound, below Scene::removal_height or beyond the scene bounds is
   /// taken out of the simulation and counted; a part whose centre crossed a fixture surface,
-  /// that left the feeder or that is faster than its physical bound is counted and kept. Nothing is thrown for a bad state: the first part of each kind is named
-  /// on stderr, the counts are in health().
+  /// that left the feeder or that is faster than its physical bound is counted and kept. Nothing is
+  /// thrown for a bad state: the first part of each kind is named on stderr, the counts are in
+  /// health().
   virtual void step() = 0;
   /// Simulated time (s).
   virtual double time() const = 0;
