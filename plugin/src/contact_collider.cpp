@@ -47,9 +47,9 @@ void ContactCollider::setSurfaceCallback(SurfaceCallback callback) {
 void ContactCollider::clearJoints() {
   dJointGroupEmpty(group_);
   joints_.clear();
-  paired_.clear();
   sweeps_.clear();
   sweep_of_proxy_.clear();
+  sweep_of_geom_.clear();
   feedback_used_ = 0;
   speculative_count_ = 0;
 }
@@ -75,7 +75,9 @@ void ContactCollider::collide(dSpaceID space, double time, double step) {
   }
   if (!error_) collideWithin(space);
   if (speculative) {
-    for (const Sweep& s : sweeps_) dSpaceRemove(dGeomGetSpace(s.proxy), s.proxy);
+    for (const Sweep& s : sweeps_) {
+      if (dSpaceID in = dGeomGetSpace(s.proxy)) dSpaceRemove(in, s.proxy);
+    }
     if (!error_) {
       try {
         castSweeps(step);
@@ -139,7 +141,14 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
   dContact* contacts = buffer_.data();
   int n = dCollide(o1, o2, settings_.max_contacts_per_pair, &contacts[0].geom, sizeof(dContact));
   if (n <= 0) return;
-  if (settings_.speculative) paired_.emplace_back(o1 < o2 ? o1 : o2, o1 < o2 ? o2 : o1);
+  if (!sweep_of_geom_.empty()) {  // a swept geom in contact already needs no ray to it
+    if (const auto it = sweep_of_geom_.find(o1); it != sweep_of_geom_.end()) {
+      sweeps_[it->second].touching.push_back(o2);
+    }
+    if (const auto it = sweep_of_geom_.find(o2); it != sweep_of_geom_.end()) {
+      sweeps_[it->second].touching.push_back(o1);
+    }
+  }
   addContacts(o1, o2, contacts, n, nullptr);
 }
 
@@ -354,14 +363,15 @@ void ContactCollider::placeSweeps(dSpaceID space, double step) {
     s.proxy = proxies_[sweeps_.size()];
     dGeomBoxSetLengths(s.proxy, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
     dGeomSetPosition(s.proxy, 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]));
-    dSpaceAdd(space, s.proxy);
     sweep_of_proxy_[s.proxy] = sweeps_.size();
+    sweep_of_geom_[g] = sweeps_.size();
+    const dGeomID proxy = s.proxy;
     sweeps_.push_back(std::move(s));
+    dSpaceAdd(space, proxy);  // last: collide() takes out every proxy that is in a space
   }
 }
 
 void ContactCollider::castSweeps(double step) {
-  std::sort(paired_.begin(), paired_.end());
   if (!ray_) {
     ray_ = dCreateRay(nullptr, 1);
     dGeomRaySetClosestHit(ray_, 1);
@@ -377,8 +387,7 @@ void ContactCollider::castSweeps(double step) {
     double gap_speed[8];
     for (dGeomID other : s.candidates) {
       if (other == geom || dGeomGetBody(other) == body) continue;
-      const auto key = std::make_pair(geom < other ? geom : other, geom < other ? other : geom);
-      if (std::binary_search(paired_.begin(), paired_.end(), key)) continue;
+      if (std::find(s.touching.begin(), s.touching.end(), other) != s.touching.end()) continue;
       int n = 0;
       for (int i = 0; i < np && n < static_cast<int>(contacts.size()) && n < 8; ++i) {
         if (dGeomGetClass(other) == dBoxClass &&

@@ -180,18 +180,19 @@ class ContactCollider {
   std::size_t feedback_used_ = 0;
   std::vector<Joint> joints_;
   std::exception_ptr error_;  // first exception caught in the near callback, not yet rethrown
-  // Speculative pass: the regular pass's pairs; each fast geom's sweep (its swept box, a
-  // proxy geom of ours, and the geoms the box met); the proxies' pool and the ray (created on
-  // first use); the count of speculative contacts.
+  // Speculative pass: each fast geom's sweep (its swept box, a proxy geom of ours; the geoms
+  // the box met and those the regular pass already gave it contacts with), looked up by proxy
+  // and by geom; the proxies' pool and the ray (created on first use); the count of
+  // speculative contacts.
   struct Sweep {
     dGeomID geom = nullptr, proxy = nullptr;
     double dir[3] = {0, 0, 0};  // unit direction of the motion (world)
     double travel = 0;          // m in the step
     std::vector<dGeomID> candidates;
+    std::vector<dGeomID> touching;  // geoms the regular pass gave it contacts with
   };
-  std::vector<std::pair<dGeomID, dGeomID>> paired_;
   std::vector<Sweep> sweeps_;
-  std::unordered_map<dGeomID, std::size_t> sweep_of_proxy_;
+  std::unordered_map<dGeomID, std::size_t> sweep_of_proxy_, sweep_of_geom_;
   std::vector<dGeomID> proxies_;
   dGeomID ray_ = nullptr;
   int speculative_count_ = 0;
