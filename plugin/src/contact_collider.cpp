@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -10,6 +11,11 @@
 #include "stage_clock.hpp"
 
 namespace rheofeed {
+
+bool odeHasContactWarmStart() {
+  static const bool has = dCheckConfiguration("ODE_EXT_contact_warm_start") != 0;
+  return has;
+}
 
 ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders)
     : ContactCollider(world, feeders, Settings{}) {}
@@ -26,6 +32,22 @@ ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders, const Setti
     throw std::invalid_argument("rheofeed::ContactCollider: Settings::speculative_fraction = " +
                                 std::to_string(settings.speculative_fraction) +
                                 " must be finite and > 0");
+  }
+  if (!(settings.warm_start_distance > 0) || !std::isfinite(settings.warm_start_distance)) {
+    throw std::invalid_argument("rheofeed::ContactCollider: Settings::warm_start_distance = " +
+                                std::to_string(settings.warm_start_distance) +
+                                " m must be finite and > 0");
+  }
+  if (!(settings.warm_start_factor > 0 && settings.warm_start_factor <= 1)) {
+    throw std::invalid_argument("rheofeed::ContactCollider: Settings::warm_start_factor = " +
+                                std::to_string(settings.warm_start_factor) + " must be in (0, 1]");
+  }
+  if (settings.warm_start && !odeHasContactWarmStart()) {
+    throw std::invalid_argument(
+        "rheofeed::ContactCollider: Settings::warm_start = true needs an ODE with rheofeed's "
+        "warm-start patch (patches/0005, dCheckConfiguration(\"ODE_EXT_contact_warm_start\")), "
+        "but the linked ODE reports \"" +
+        std::string(dGetConfiguration()) + "\"");
   }
   requireFrictionModel(settings.friction, "rheofeed::ContactCollider: Settings::friction");
   settings_.default_surface.mode =
@@ -52,6 +74,7 @@ void ContactCollider::clearJoints() {
   sweep_of_geom_.clear();
   feedback_used_ = 0;
   speculative_count_ = 0;
+  warm_started_count_ = 0;
 }
 
 void ContactCollider::rethrowPendingError() {
@@ -64,6 +87,7 @@ void ContactCollider::rethrowPendingError() {
 void ContactCollider::collide(dSpaceID space, double time, double step) {
   rethrowPendingError();           // an error of a manual pass is not lost
   feeders_.beginStep(time, step);  // first: a refused time or step leaves everything as it was
+  if (settings_.warm_start) keepWarmStarts();
   clearJoints();
   const bool speculative = settings_.speculative && step > 0;
   if (speculative) {
@@ -179,6 +203,8 @@ void ContactCollider::addContacts(dGeomID o1, dGeomID o2, dContact* contacts, in
   std::vector<ContactRecord>& records = feeders_.records();
   const std::size_t first_record = records.size();
   n = feeders_.driveContacts(contacts, n);
+  const bool warm = settings_.warm_start && !gap_speed && !warm_.empty();
+  if (warm) applyWarmStarts(o1, o2, contacts, n);
   const bool recorded = records.size() > first_record;
   std::size_t next_record = first_record;
   const bool feeder_pair = recorded && (feeders_.contains(o1) || feeders_.contains(o2));
@@ -199,20 +225,101 @@ void ContactCollider::addContacts(dGeomID o1, dGeomID o2, dContact* contacts, in
       joint = dJointCreateContact(world_, group_, &contacts[i]);
     }
     dJointAttach(joint, a, b);
+    // feedback f1 is the force on the joint's first body: a, or b when a is 0 (ODE keeps the
+    // non-null body first); a is g1's body unless g2_first swapped them
+    const bool first_body_is_g1 = (a != nullptr) != g2_first;
     dJointFeedback* fb = nullptr;
-    if (settings_.feedback) {
+    if (settings_.feedback || settings_.warm_start) {
       if (feedback_used_ == feedback_.size()) feedback_.emplace_back();
       fb = &feedback_[feedback_used_++];
+      *fb = dJointFeedback{};
+      if (warm && warm_force_[static_cast<std::size_t>(i)].first) {
+        const Vec3 f = warm_force_[static_cast<std::size_t>(i)].second;  // on g1's body
+        const Vec3 f1 = first_body_is_g1 ? f : -f;
+        fb->f1[0] = f1.x;
+        fb->f1[1] = f1.y;
+        fb->f1[2] = f1.z;
+      }
       dJointSetFeedback(joint, fb);
     }
     const dReal* n_i = contacts[i].geom.normal;
-    joints_.push_back(
-        {contacts[i].geom.g1, contacts[i].geom.g2, {n_i[0], n_i[1], n_i[2]}, joint, fb});
+    const dReal* p_i = contacts[i].geom.pos;
+    joints_.push_back({contacts[i].geom.g1,
+                       contacts[i].geom.g2,
+                       {n_i[0], n_i[1], n_i[2]},
+                       joint,
+                       fb,
+                       {p_i[0], p_i[1], p_i[2]},
+                       first_body_is_g1});
     if (feeder_pair && next_record < records.size()) {
       ContactRecord& r = records[next_record++];
       r.joint = joint;
       r.feedback = fb;
     }
+  }
+}
+
+namespace {
+// Warm start: a previous contact gives its force only to a new one whose normal is within
+// about 18 degrees of its own (cos 0.95); a contact that changed feature (an edge of a thin
+// blade instead of its face) starts from zero.
+constexpr double kWarmStartNormalCos = 0.95;
+}  // namespace
+
+void ContactCollider::keepWarmStarts() {
+  warm_.clear();
+  for (const Joint& j : joints_) {
+    if (!j.feedback) continue;
+    const dReal* f1 = j.feedback->f1;
+    Vec3 on_g1{f1[0], f1[1], f1[2]};
+    if (!j.first_body_is_g1) on_g1 = -on_g1;
+    if (!isFinite(on_g1)) continue;  // a diverged step gives no start
+    const bool g1_lo = std::less<dGeomID>()(j.g1, j.g2);
+    // the normal (from g2 into g1) turned to point into lo
+    warm_.push_back({g1_lo ? j.g1 : j.g2, g1_lo ? j.g2 : j.g1, j.position,
+                     g1_lo ? j.normal : -j.normal, g1_lo ? on_g1 : -on_g1, false});
+  }
+  std::sort(warm_.begin(), warm_.end(), [](const WarmContact& x, const WarmContact& y) {
+    return std::less<dGeomID>()(x.lo, y.lo) || (x.lo == y.lo && std::less<dGeomID>()(x.hi, y.hi));
+  });
+}
+
+void ContactCollider::applyWarmStarts(dGeomID o1, dGeomID o2, dContact* contacts, int n) {
+  warm_force_.assign(static_cast<std::size_t>(n), {false, Vec3{}});
+  const bool o1_lo = std::less<dGeomID>()(o1, o2);
+  const dGeomID lo = o1_lo ? o1 : o2, hi = o1_lo ? o2 : o1;
+  const auto first =
+      std::lower_bound(warm_.begin(), warm_.end(), std::make_pair(lo, hi),
+                       [](const WarmContact& x, const std::pair<dGeomID, dGeomID>& key) {
+                         return std::less<dGeomID>()(x.lo, key.first) ||
+                                (x.lo == key.first && std::less<dGeomID>()(x.hi, key.second));
+                       });
+  const double reach2 = settings_.warm_start_distance * settings_.warm_start_distance;
+  for (int i = 0; i < n; ++i) {
+    const dReal* p = contacts[i].geom.pos;
+    const bool g1_lo = contacts[i].geom.g1 == lo;
+    const dReal* nrm = contacts[i].geom.normal;
+    const Vec3 normal_into_lo =
+        g1_lo ? Vec3{nrm[0], nrm[1], nrm[2]} : Vec3{-nrm[0], -nrm[1], -nrm[2]};
+    WarmContact* best = nullptr;
+    double best2 = reach2;
+    for (auto it = first; it != warm_.end() && it->lo == lo && it->hi == hi; ++it) {
+      // the same point of the same feature: near, and with nearly the same normal
+      if (it->used || dot(it->normal, normal_into_lo) < kWarmStartNormalCos) continue;
+      const Vec3 d{p[0] - it->position.x, p[1] - it->position.y, p[2] - it->position.z};
+      const double d2 = dot(d, d);
+      if (d2 <= best2) {
+        best2 = d2;
+        best = &*it;
+      }
+    }
+    if (!best) continue;
+    best->used = true;
+    // the force on the body of this contact's g1 (the previous force was on lo's body)
+    const double f = settings_.warm_start_factor;
+    warm_force_[static_cast<std::size_t>(i)] = {true, f * (g1_lo ? best->force : -best->force)};
+    contacts[i].surface.mode |= kContactWarmStart;
+    ++warm_started_count_;
   }
 }
 

@@ -37,6 +37,20 @@
 /// it closes. The contacts go through the SurfaceCallback and the FeederSet like any other
 /// (the motionN is set after the callback) and are counted (speculativeContactCount).
 ///
+/// ## Warm start
+/// ODE's quickstep starts every row from zero, so a heap's weight is rebuilt from nothing each
+/// step, one layer per Gauss-Seidel sweep, and stays short of it at a fixed iteration count.
+/// With Settings::warm_start (the patched ODE: patches/0005, odeHasContactWarmStart()),
+/// collide() first reads the force each contact joint of the previous pass applied in the step
+/// between (its dJointFeedback), and gives each new contact of the same geom pair whose point
+/// lies within Settings::warm_start_distance of a previous one whose normal is within about 18
+/// degrees of its own (the nearest, each used once) that force, times
+/// Settings::warm_start_factor, as its starting point: the surface mode gains
+/// dContactWarmStart and the joint's feedback f1 holds the force before the step. The iterations go
+/// on from there, with the same bounds (the result is still a quickstep solution, reached from a
+/// nearer start). Contacts warm-started are counted (warmStartedContactCount). Only collide() reads
+/// the previous pass: a manual dSpaceCollide pass starts from zero.
+///
 /// ## Friction model
 /// Settings::friction sets dContactFrictionCone (cone) or clears it (pyramid) on every contact
 /// before the SurfaceCallback, which may choose per contact. A contact that asks for the cone
@@ -102,11 +116,27 @@ class ContactCollider {
     /// swept (finite, > 0); 0.25 catches a part well before it can pass through anything as
     /// thick as itself.
     double speculative_fraction = 0.25;
+    /// Warm start (file comment): each contact starts from the force (N) of the previous
+    /// step's contact of the same geom pair nearest to its point, within warm_start_distance.
+    /// Needs the patched ODE (odeHasContactWarmStart()) and dWorldQuickStep on one thread;
+    /// attaches a dJointFeedback to every contact joint. Off by default.
+    bool warm_start = false;
+    /// Largest distance (m, finite, > 0) between a contact point and the previous step's point
+    /// it takes its warm start from: 1 mm, well above a resting part's motion in a step and
+    /// below the distance between the corners of the smallest parts in the demos (5 mm).
+    double warm_start_distance = 1e-3;
+    /// Fraction (0, 1] of the previous force a contact starts from. A full start (1) lets a
+    /// column of 12 cubes at 10 iterations oscillate for good (the previous step's force
+    /// includes ERP's push against the overlap, which it then repeats), as 0.95 does, and 0.9
+    /// let it jump once at 20 iterations; 0.8 held every column measured (6-20 cubes, 5-40
+    /// iterations; tests/plugin/contact_collider_test.cpp), each settling less than from zero.
+    double warm_start_factor = 0.8;
   };
 
   /// `world` receives the joints; `feeders` must outlive the collider. Throws
-  /// std::invalid_argument for a null world, max_contacts_per_pair outside 1..65535, or friction
-  /// = Cone on an ODE without the cone.
+  /// std::invalid_argument for a null world, max_contacts_per_pair outside 1..65535, a bad
+  /// speculative_fraction, warm_start_distance or warm_start_factor, friction = Cone on an ODE
+  /// without the cone, or warm_start on an ODE without warm starts.
   ContactCollider(dWorldID world, FeederSet& feeders);
   ContactCollider(dWorldID world, FeederSet& feeders, const Settings& settings);
   ~ContactCollider();
@@ -144,11 +174,16 @@ class ContactCollider {
     Vec3 normal;                         ///< unit contact normal (world, from g2 into g1)
     dJointID joint;                      ///< attached (body(g1), body(g2)) or the reverse
     dJointFeedback* feedback = nullptr;  ///< forces (N, world) after the step if Settings::feedback
+                                         ///< or Settings::warm_start
+    Vec3 position;                       ///< contact point (m, world)
+    bool first_body_is_g1 = true;        ///< whether feedback->f1 acts on g1's body (else g2's)
   };
   /// Contact joints created since the last clearJoints.
   int contactCount() const { return static_cast<int>(joints_.size()); }
   /// Of those, the speculative ones (Settings::speculative): contacts across a gap.
   int speculativeContactCount() const { return speculative_count_; }
+  /// Of those, the ones that started from a previous contact's force (Settings::warm_start).
+  int warmStartedContactCount() const { return warm_started_count_; }
   const std::vector<Joint>& joints() const { return joints_; }
   dJointGroupID jointGroup() const { return group_; }
 
@@ -169,6 +204,10 @@ class ContactCollider {
   // regular pass (placeSweeps), which collects the geoms it meets; then the rays (castSweeps).
   void placeSweeps(dSpaceID space, double step);
   void castSweeps(double step);
+  // Warm start: keeps the forces of the previous pass's joints (before clearJoints), and gives
+  // the new contacts of a pair their nearest previous force.
+  void keepWarmStarts();
+  void applyWarmStarts(dGeomID o1, dGeomID o2, dContact* contacts, int n);
 
   dWorldID world_;
   FeederSet& feeders_;
@@ -197,6 +236,25 @@ class ContactCollider {
   dGeomID ray_ = nullptr;
   int speculative_count_ = 0;
   double* contact_seconds_ = nullptr;  // setContactTimer
+  // Warm start: the previous pass's contacts, sorted by geom pair (lo < hi by address), each
+  // with the force (N, world) it applied to lo's body; the force each new contact starts from,
+  // on its joint's first body (set into its feedback once the joint exists).
+  struct WarmContact {
+    dGeomID lo, hi;
+    Vec3 position, normal, force;  // normal: unit, into lo
+    bool used;
+  };
+  std::vector<WarmContact> warm_;
+  std::vector<std::pair<bool, Vec3>> warm_force_;  // per contact of the pair being added
+  int warm_started_count_ = 0;
 };
+
+/// ODE's surface mode bit for a warm start (dContactWarmStart of the patched contact.h), defined
+/// here so that rheofeed compiles against stock headers.
+constexpr int kContactWarmStart = 0x10000;
+
+/// Whether the ODE library linked at run time has contact warm starts: dCheckConfiguration(
+/// "ODE_EXT_contact_warm_start"), the token patches/0005 adds to dGetConfiguration().
+bool odeHasContactWarmStart();
 
 }  // namespace rheofeed

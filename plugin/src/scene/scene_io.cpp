@@ -589,6 +589,8 @@ Scene readScene(const json& root) {
     m.opt("surface_layer", x.surface_layer, Range::NonNegative);
     bool speculative = true;
     if (m.opt("speculative_contacts", speculative)) x.speculative_contacts = speculative;
+    bool warm_start = true;
+    if (m.opt("warm_start", warm_start)) x.warm_start = warm_start;
     m.finish();
   }
   o.opt("duration", s.duration, Range::Positive);

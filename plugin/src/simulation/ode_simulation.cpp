@@ -77,6 +77,8 @@ class OdeSimulation final : public PartSimulation {
     cs.feedback = true;
     cs.friction = friction;
     cs.speculative = scene.solver.speculative_contacts.value_or(true);
+    cs.warm_start =
+        scene.solver.ode_quickstep && scene.solver.warm_start.value_or(odeHasContactWarmStart());
     collider_ = std::make_unique<ContactCollider>(world_, *feeders_, cs);
     const double mu = scene.material.mu, bounce = scene.material.restitution;
     const int mode =
@@ -123,6 +125,7 @@ class OdeSimulation final : public PartSimulation {
         collider_->collide(space_, t, h);  // laws frozen on [t, t + h] (secant surface velocity)
       }
       health_.speculative_contacts += collider_->speculativeContactCount();
+      health_.warm_started_contacts += collider_->warmStartedContactCount();
       times.collision += collide_seconds - (times.contacts - contacts_before);
     }
     {
@@ -192,6 +195,9 @@ class OdeSimulation final : public PartSimulation {
     if (s.apgd != defaults.apgd) ignored("apgd", s.apgd, "reference solver only");
     if (!s.ode_quickstep && s.iterations != defaults.iterations) {
       ignored("iterations", s.iterations, "ode_quickstep = false: dWorldStep is a direct solver");
+    }
+    if (!s.ode_quickstep && s.warm_start.value_or(false)) {
+      ignored("warm_start", true, "ode_quickstep = false: dWorldStep is a direct solver");
     }
   }
 

@@ -190,6 +190,11 @@ class ReferenceSimulation final : public PartSimulation {
           "solver.speculative_contacts = true: ignored by the reference solver (it makes "
           "contacts only where geoms overlap)");
     }
+    if (scene_.solver.warm_start.value_or(false)) {
+      ignoreSetting(
+          "solver.warm_start = true: ignored by the reference solver (its own solvers warm "
+          "start as their settings say)");
+    }
     if (!scene_.solver.ode_quickstep) {
       ignoreSetting(
           "solver.ode_quickstep = false: ignored by the reference solver (ODE's stepper choice)");

@@ -142,6 +142,10 @@ struct RunHealth {
   /// across a gap over the run (summed over steps; 0 when off and for the reference engine).
   /// Informative, not a loss.
   long speculative_contacts = 0;
+  /// ODE runs with warm starts (SolverSettings::warm_start): contacts whose solve started from
+  /// the previous step's force of the same contact (summed over steps; 0 when off and for the
+  /// reference engine). Informative.
+  long warm_started_contacts = 0;
   /// Parts lost in any way but the exit: fell + through_fixture + left_feeder + out_of_bounds +
   /// nonfinite + too_fast, plus those inside a fixture now.
   int partsLost() const {
