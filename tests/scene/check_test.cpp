@@ -167,6 +167,7 @@ double stackPenetration(double ratio, int iterations, double h, double edge, Met
   s.parts.push_back(cubes(edge, light, {0, 0, edge / 2}, {0, 0, edge / 2}));
   s.parts.push_back(cubes(edge, light * ratio, {0, 0, 2.3 * edge}, {0, 0, 2.3 * edge}));
   s.solver.time_step = h;
+  s.outputs.sample_interval = std::max(s.outputs.sample_interval, h);  // at most once per step
   s.solver.iterations = iterations;
   if (method == Method::OdeRheonomic) s.solver.warm_start = warm_start;
   s.duration = 2;
@@ -240,6 +241,11 @@ TEST(SceneCheck, DISABLED_MassRatioProbe) {
   const double ratios[] = {1,   1.5, 2,   3,   5,   7,    10,   15,   20,   30,   50,   70,   100,
                            150, 200, 300, 500, 700, 1000, 1500, 2000, 3000, 5000, 7000, 10000};
   const char* only = std::getenv("RHEOFEED_PROBE");
+  // RHEOFEED_PROBE_POINT="edge,X,k" (e.g. "0.002,20,200"): that grid point only.
+  const char* point = std::getenv("RHEOFEED_PROBE_POINT");
+  double point_edge = 0, point_x = 0;
+  int point_k = 0;
+  if (point) std::sscanf(point, "%lf,%lf,%d", &point_edge, &point_x, &point_k);
   const struct {
     const char* name;
     Method method;
@@ -250,9 +256,12 @@ TEST(SceneCheck, DISABLED_MassRatioProbe) {
   for (const auto& run : runs) {
     if (only && std::string(only) != run.name) continue;
     for (double edge : {0.002, 0.01, 0.05}) {
+      if (point && edge != point_edge) continue;
       for (double x : {5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 2000.0, 8000.0}) {
+        if (point && x != point_x) continue;
         const double h = std::sqrt(edge / (kG * x));
         for (int k : {10, 20, 50, 100, 200}) {
+          if (point && k != point_k) continue;
           double hold = 0, crush = 0;
           for (double r : ratios) {
             if (stackPenetration(r, k, h, edge, run.method, run.warm) > edge / 4) {
