@@ -233,8 +233,8 @@ void ContactCollider::addContacts(dGeomID o1, dGeomID o2, dContact* contacts, in
       if (feedback_used_ == feedback_.size()) feedback_.emplace_back();
       fb = &feedback_[feedback_used_++];
       *fb = dJointFeedback{};
-      if (warm && warm_force_[static_cast<std::size_t>(i)].first) {
-        const Vec3 f = warm_force_[static_cast<std::size_t>(i)].second;  // on g1's body
+      if (warm && warm_force_[static_cast<std::size_t>(i)].has_force) {
+        const Vec3 f = warm_force_[static_cast<std::size_t>(i)].force;  // on g1's body
         const Vec3 f1 = first_body_is_g1 ? f : -f;
         fb->f1[0] = f1.x;
         fb->f1[1] = f1.y;
@@ -244,13 +244,15 @@ void ContactCollider::addContacts(dGeomID o1, dGeomID o2, dContact* contacts, in
     }
     const dReal* n_i = contacts[i].geom.normal;
     const dReal* p_i = contacts[i].geom.pos;
+    const bool persisted = warm && warm_force_[static_cast<std::size_t>(i)].persisted;
     joints_.push_back({contacts[i].geom.g1,
                        contacts[i].geom.g2,
                        {n_i[0], n_i[1], n_i[2]},
                        joint,
                        fb,
                        {p_i[0], p_i[1], p_i[2]},
-                       first_body_is_g1});
+                       first_body_is_g1,
+                       persisted});
     if (feeder_pair && next_record < records.size()) {
       ContactRecord& r = records[next_record++];
       r.joint = joint;
@@ -277,7 +279,7 @@ void ContactCollider::keepWarmStarts() {
     const bool g1_lo = std::less<dGeomID>()(j.g1, j.g2);
     // the normal (from g2 into g1) turned to point into lo
     warm_.push_back({g1_lo ? j.g1 : j.g2, g1_lo ? j.g2 : j.g1, j.position,
-                     g1_lo ? j.normal : -j.normal, g1_lo ? on_g1 : -on_g1, false});
+                     g1_lo ? j.normal : -j.normal, g1_lo ? on_g1 : -on_g1, j.persisted, false});
   }
   std::sort(warm_.begin(), warm_.end(), [](const WarmContact& x, const WarmContact& y) {
     return std::less<dGeomID>()(x.lo, y.lo) || (x.lo == y.lo && std::less<dGeomID>()(x.hi, y.hi));
@@ -285,7 +287,7 @@ void ContactCollider::keepWarmStarts() {
 }
 
 void ContactCollider::applyWarmStarts(dGeomID o1, dGeomID o2, dContact* contacts, int n) {
-  warm_force_.assign(static_cast<std::size_t>(n), {false, Vec3{}});
+  warm_force_.assign(static_cast<std::size_t>(n), WarmStart{});
   const bool o1_lo = std::less<dGeomID>()(o1, o2);
   const dGeomID lo = o1_lo ? o1 : o2, hi = o1_lo ? o2 : o1;
   const auto first =
@@ -315,9 +317,13 @@ void ContactCollider::applyWarmStarts(dGeomID o1, dGeomID o2, dContact* contacts
     }
     if (!best) continue;
     best->used = true;
+    WarmStart& w = warm_force_[static_cast<std::size_t>(i)];
+    w.persisted = true;
+    if (!best->persisted) continue;  // its force was a first impact's
     // the force on the body of this contact's g1 (the previous force was on lo's body)
     const double f = settings_.warm_start_factor;
-    warm_force_[static_cast<std::size_t>(i)] = {true, f * (g1_lo ? best->force : -best->force)};
+    w.has_force = true;
+    w.force = f * (g1_lo ? best->force : -best->force);
     contacts[i].surface.mode |= kContactWarmStart;
     ++warm_started_count_;
   }

@@ -6,6 +6,8 @@
 // not.
 #include "rheofeed/simulation/check.hpp"
 
+#include "rheofeed/contact_collider.hpp"
+
 #include <gtest/gtest.h>
 #include <ode/ode.h>
 
@@ -199,14 +201,16 @@ TEST(SceneCheck, MassRatioFiresWithTheMassesFromDensitiesAndEdges) {
   ASSERT_EQ(m.size(), 1u) << formatHazards(checkScene(s, Method::OdeRheonomic));
   const double light = 1000 * edge * edge * edge, heavy = 1e6 * edge * edge * edge;
   EXPECT_NEAR(m[0].value, heavy / light, kRelative * heavy / light);
-  EXPECT_EQ(m[0].limit, odeQuickstepMassRatioLimit(50, edge, h, kG));
+  // the scene's ODE run warm-starts its contacts only if it asks (solver.warm_start)
+  const bool warm = odeWarmStartsContacts(s.solver);
+  EXPECT_EQ(m[0].limit, odeQuickstepMassRatioLimit(50, edge, h, kG, warm));
   EXPECT_NE(m[0].safe_setting.find("ode_quickstep = false"), std::string::npos);
   // Dantzig (dWorldStep) solves the LCP exactly: no iteration count to run out of.
   s.solver.ode_quickstep = false;
   EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::MassRatio).empty());
   // Masses within the limit: quiet.
   s.solver.ode_quickstep = true;
-  s.parts[1].density = 1000 * odeQuickstepMassRatioLimit(50, edge, h, kG);
+  s.parts[1].density = 1000 * odeQuickstepMassRatioLimit(50, edge, h, kG, warm);
   EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::MassRatio).empty());
 }
 
@@ -221,6 +225,20 @@ TEST(SceneCheck, OdeQuickstepHoldsAStackAtTheTableLimitAndNotAtTenTimesIt) {
                  ", limit = " + std::to_string(limit));
     EXPECT_LT(stackPenetration(limit, k, h, edge, Method::OdeRheonomic), edge / 4);
     EXPECT_GT(stackPenetration(10 * limit, k, h, edge, Method::OdeRheonomic), edge / 4);
+  }
+}
+
+// With contact warm starts the limit is the smaller of the two tables; a stack at it holds.
+TEST(SceneCheck, OdeQuickstepWithWarmStartsHoldsAStackAtItsLimit) {
+  if (!odeHasContactWarmStart()) GTEST_SKIP() << "the linked ODE has no warm start (stock ODE)";
+  const double edge = 0.01;
+  for (const auto& [x, k] : {std::pair<double, int>{20, 20}, {100, 50}, {500, 100}}) {
+    const double h = std::sqrt(edge / (kG * x));
+    const double limit = odeQuickstepMassRatioLimit(k, edge, h, kG, true);
+    SCOPED_TRACE("X = " + std::to_string(x) + ", k = " + std::to_string(k) +
+                 ", limit = " + std::to_string(limit));
+    EXPECT_LE(limit, odeQuickstepMassRatioLimit(k, edge, h, kG, false));
+    EXPECT_LT(stackPenetration(limit, k, h, edge, Method::OdeRheonomic, true), edge / 4);
   }
 }
 

@@ -46,7 +46,10 @@
 /// lies within Settings::warm_start_distance of a previous one whose normal is within about 18
 /// degrees of its own (the nearest, each used once) that force, times
 /// Settings::warm_start_factor, as its starting point: the surface mode gains
-/// dContactWarmStart and the joint's feedback f1 holds the force before the step. The iterations go
+/// dContactWarmStart and the joint's feedback f1 holds the force before the step. A contact's
+/// first force is not passed on: it holds the impulse of an impact (a part landing), which
+/// repeated in the next step throws the part back up; a contact passes its force on from its
+/// second step. The iterations go
 /// on from there, with the same bounds (the result is still a quickstep solution, reached from a
 /// nearer start). Contacts warm-started are counted (warmStartedContactCount). Only collide() reads
 /// the previous pass: a manual dSpaceCollide pass starts from zero.
@@ -128,7 +131,7 @@ class ContactCollider {
     /// Fraction (0, 1] of the previous force a contact starts from. A full start (1) lets a
     /// column of 12 cubes at 10 iterations oscillate for good (the previous step's force
     /// includes ERP's push against the overlap, which it then repeats), as 0.95 does, and 0.9
-    /// let it jump once at 20 iterations; 0.8 held every column measured (6-20 cubes, 5-40
+    /// let it jump once at 20 iterations; 0.8 held every column measured (6-20 cubes, 10-40
     /// iterations; tests/plugin/contact_collider_test.cpp), each settling less than from zero.
     double warm_start_factor = 0.8;
   };
@@ -177,6 +180,7 @@ class ContactCollider {
                                          ///< or Settings::warm_start
     Vec3 position;                       ///< contact point (m, world)
     bool first_body_is_g1 = true;        ///< whether feedback->f1 acts on g1's body (else g2's)
+    bool persisted = false;  ///< Settings::warm_start: matched to a contact of the previous pass
   };
   /// Contact joints created since the last clearJoints.
   int contactCount() const { return static_cast<int>(joints_.size()); }
@@ -242,10 +246,17 @@ class ContactCollider {
   struct WarmContact {
     dGeomID lo, hi;
     Vec3 position, normal, force;  // normal: unit, into lo
+    bool persisted;                // it was itself matched: its force is no first impact
     bool used;
   };
   std::vector<WarmContact> warm_;
-  std::vector<std::pair<bool, Vec3>> warm_force_;  // per contact of the pair being added
+  // Per contact of the pair being added: matched (persisted), and the force it starts from
+  // (on its g1's body) when it has one.
+  struct WarmStart {
+    bool persisted = false, has_force = false;
+    Vec3 force;
+  };
+  std::vector<WarmStart> warm_force_;
   int warm_started_count_ = 0;
 };
 

@@ -77,8 +77,7 @@ class OdeSimulation final : public PartSimulation {
     cs.feedback = true;
     cs.friction = friction;
     cs.speculative = scene.solver.speculative_contacts.value_or(true);
-    cs.warm_start =
-        scene.solver.ode_quickstep && scene.solver.warm_start.value_or(odeHasContactWarmStart());
+    cs.warm_start = odeWarmStartsContacts(scene.solver);
     collider_ = std::make_unique<ContactCollider>(world_, *feeders_, cs);
     const double mu = scene.material.mu, bounce = scene.material.restitution;
     const int mode =

@@ -661,6 +661,10 @@ FrictionModel odeFrictionModel(const SolverSettings& solver) {
   return *solver.friction;
 }
 
+bool odeWarmStartsContacts(const SolverSettings& solver) {
+  return solver.ode_quickstep && solver.warm_start.value_or(false);
+}
+
 std::unique_ptr<Simulation> makeSimulation(const Scene& scene, Method method) {
   scene.validate();
   if (method == Method::OdeRheonomic || method == Method::OdeFullVibration) {

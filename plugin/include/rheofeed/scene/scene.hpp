@@ -233,8 +233,9 @@ struct SolverSettings {
   /// ODE runs with quickstep: warm starts (contact_collider.hpp, ContactCollider::Settings::
   /// warm_start): each contact's solve starts from the force the same contact applied in the
   /// previous step, so that a heap's weight is carried over instead of rebuilt from zero by the
-  /// iterations. Unset: on where the linked ODE has it (rheofeed's patched ODE, patches/0005)
-  /// and ode_quickstep is true, else off. True on a stock ODE is refused by the ODE simulation;
+  /// iterations. Unset: off (odeWarmStartsContacts, simulation.hpp, says what it gains and
+  /// costs). Needs rheofeed's patched ODE (patches/0005): true on a stock ODE is refused by the
+  /// ODE simulation;
   /// true with ode_quickstep = false (a direct solver) and in the reference engine is an
   /// ignored setting.
   std::optional<bool> warm_start;

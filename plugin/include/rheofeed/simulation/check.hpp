@@ -128,7 +128,10 @@ std::vector<std::string> reportSceneCheck(const Scene& scene, Method method);
 /// the measured table in check.cpp (conservative: the measured grid point at or below the
 /// arguments, halved for quickstep's random constraint order). Returns 1 below the measured grid
 /// (any ratio above 1 warns) and 0 where even equal masses were crushed (any stack warns).
-double odeQuickstepMassRatioLimit(int iterations, double thickness, double time_step, double g);
+/// `warm_start`: the run warm-starts its contacts (SolverSettings::warm_start); the limit is
+/// then the smaller of the tables measured with and without warm starts at each point.
+double odeQuickstepMassRatioLimit(int iterations, double thickness, double time_step, double g,
+                                  bool warm_start = false);
 
 /// As odeQuickstepMassRatioLimit for the reference solver (CCP, APGD or PGS, `iterations` =
 /// the CCP iteration budget).

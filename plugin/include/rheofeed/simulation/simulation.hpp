@@ -319,4 +319,11 @@ std::unique_ptr<Simulation> makeSimulation(const Scene& scene, Method method);
 /// solver.friction for the cone with ode_quickstep = false or on an ODE without the cone.
 FrictionModel odeFrictionModel(const SolverSettings& solver);
 
+/// Whether an ODE run with these settings warm-starts its contacts
+/// (ContactCollider::Settings::warm_start): solver.warm_start with ode_quickstep (dWorldStep has
+/// no use for it). Off unless the scene asks: it halves a heap's drift error at 30 iterations
+/// and lost no part of the main demo, but the mass-ratio probe held stacks of unequal parts up
+/// to 15 times worse with it at some grid points (check_mass_ratio.cpp).
+bool odeWarmStartsContacts(const SolverSettings& solver);
+
 }  // namespace rheofeed::scene
