@@ -38,6 +38,7 @@ void BowlPhaseObserver::onStep(const scene::Simulation& sim, long, bool sample) 
     Part& p = parts_[static_cast<std::size_t>(i)];
     if (!s.active) {
       p.seen = false;
+      p.window_turn = p.window_seconds = 0;
       continue;
     }
     const BowlPhase phase = bowlPhase(s.position);
@@ -48,6 +49,21 @@ void BowlPhaseObserver::onStep(const scene::Simulation& sim, long, bool sample) 
         const auto k = static_cast<std::size_t>(phase);
         p.turn[k] += angle - p.angle;
         p.seconds[k] += t - p.time;
+        p.window_turn += angle - p.angle;
+        p.window_seconds += t - p.time;
+        if (p.window_seconds >= kStallWindow - 1e-9) {
+          Windows& w = windows_[k];
+          if (p.window_turn < kStallDrift * p.window_seconds) {
+            ++w.stalled;
+          } else {
+            ++w.moving;
+            w.moving_turn += p.window_turn;
+            w.moving_seconds += p.window_seconds;
+          }
+          p.window_turn = p.window_seconds = 0;
+        }
+      } else {  // a window lies in one phase
+        p.window_turn = p.window_seconds = 0;
       }
     }
     p.seen = true;
@@ -78,6 +94,10 @@ PhaseDrift BowlPhaseObserver::drift(BowlPhase phase) const {
     }
   }
   if (d.part_seconds > 0) d.drift = turn / d.part_seconds;
+  const Windows& w = windows_[k];
+  d.windows = w.stalled + w.moving;
+  if (d.windows > 0) d.stalled_share = static_cast<double>(w.stalled) / d.windows;
+  if (w.moving_seconds > 0) d.moving_drift = w.moving_turn / w.moving_seconds;
   if (d.parts > 1) {
     const double mean = sum / d.parts;
     const double var = std::max(0.0, (sum2 - d.parts * mean * mean) / (d.parts - 1));

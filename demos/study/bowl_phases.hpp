@@ -44,7 +44,18 @@ struct PhaseDrift {
   double ci95 = 0;          ///< 1.96 sd / sqrt(n) over the parts' own drifts (parts >= 1 s in it)
   double part_seconds = 0;  ///< time spent in the phase, summed over the parts (s)
   int parts = 0;            ///< parts that spent at least 1 s in it
+  /// The phase's time cut into windows of kStallWindow per part: the share of windows in which
+  /// the part turned slower than kStallDrift (stuck in a jam or a wedge), and the drift over the
+  /// other windows (rad/s; 0 when none).
+  double stalled_share = 0;
+  double moving_drift = 0;
+  int windows = 0;  ///< windows counted
 };
+
+/// Window (s) and drift below which a part counts as stalled (rad/s: 0.02 rad/s is 2.9 mm/s at
+/// r = 145 mm, a fifth of a single nut's drift on the ramp).
+constexpr double kStallWindow = 2.0;
+constexpr double kStallDrift = 0.02;
 
 /// Watches a run of the primitive bowl: on each metric sample after `warmup` (s), each active
 /// part that is in the same phase at both ends of the sample interval adds its turn about +z
@@ -66,7 +77,13 @@ class BowlPhaseObserver : public scene::RunObserver {
     double time = 0, angle = 0;  // last sample (s, unwrapped rad)
     BowlPhase phase = BowlPhase::Other;
     double turn[kBowlPhaseCount] = {}, seconds[kBowlPhaseCount] = {};
+    double window_turn = 0, window_seconds = 0;  // the current stall window (its phase: phase)
   };
+  struct Windows {
+    int stalled = 0, moving = 0;
+    double moving_turn = 0, moving_seconds = 0;
+  };
+  Windows windows_[kBowlPhaseCount];
   double warmup_;
   bool keep_trace_;
   std::vector<Part> parts_;

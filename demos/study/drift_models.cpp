@@ -153,6 +153,17 @@ struct SceneResult {
   ModelResult models[kModelCount];
 };
 
+// What a phase's drift is made of: time in it, stalled windows, drift while moving.
+std::string phaseNote(const PhaseDrift& d) {
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "%.0f part-seconds, %.0f %% of %d windows of %.0f s stalled (< %.2g rad/s), "
+                "moving at %.4g rad/s",
+                d.part_seconds, 100 * d.stalled_share, d.windows, kStallWindow, kStallDrift,
+                d.moving_drift);
+  return text;
+}
+
 Scene withDriftModel(Scene s, int fixture, DriftModel model) {
   s.fixtures[static_cast<std::size_t>(fixture)].law.drift_model = model;
   return s;
@@ -247,6 +258,11 @@ bool writeOutputs(const DriftModelStudyOptions& o, const std::vector<SceneResult
     md << "- " << r.name << ": " << r.what;
     if (!r.models[1].note.empty()) md << "; local_sampled: " << r.models[1].note;
     if (!r.models[3].ran && !r.models[3].note.empty()) md << "; classical: " << r.models[3].note;
+    if (r.part_seconds > 0) {  // bowl phases: every model's phase note
+      for (int k : {0, kSceneConstant}) {
+        if (r.models[k].ran) md << "; " << kModels[k] << ": " << r.models[k].note;
+      }
+    }
     md << "\n";
   }
   const std::filesystem::path out(o.out_dir);
@@ -367,6 +383,9 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
             measured.phases[p].drift += d.drift / o.seeds;
             measured.phases[p].part_seconds += d.part_seconds;
             measured.phases[p].parts += d.parts;
+            measured.phases[p].stalled_share += d.stalled_share / o.seeds;
+            measured.phases[p].moving_drift += d.moving_drift / o.seeds;
+            measured.phases[p].windows += d.windows;
             if (k == 0) measured.phases[p].ci95 = d.ci95;
           }
           if (k == 0) {
@@ -451,7 +470,6 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
         rheonomic(3, withCalibration(scene, c));
       });
       attempt(kSceneConstant, [&] {
-        r.models[kSceneConstant].note = "the scene file's calibrated_drift";
         rheonomic(kSceneConstant, withDriftModel(scene, fixture, DriftModel::CalibratedDrift));
       });
       if (byBowlPhase(entry)) {
@@ -465,14 +483,14 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
           row.reference = judged.drift;
           row.reference_ci95 = judged.ci95;
           row.part_seconds = judged.part_seconds;
+          row.what += "; full vibration: " + phaseNote(judged);
           for (const auto& [slot, measured] : phased) {
             if (slot < 0) continue;
             const int k = slot;
             const PhaseDrift& d = measured.phases[p];
             row.models[k].drift = d.drift;
             row.models[k].ci95 = d.ci95;
-            row.models[k].note += " (" + std::to_string(static_cast<int>(d.part_seconds)) +
-                                  " part-seconds in the phase)";
+            row.models[k].note += (row.models[k].note.empty() ? "" : "; ") + phaseNote(d);
           }
           results.push_back(row);
         }
