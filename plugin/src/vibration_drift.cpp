@@ -384,9 +384,10 @@ Vec3 anyPerpendicular(const Vec3& n) {
   return (1.0 / norm(e)) * e;
 }
 
-// The point-mass drift on a gravity-loaded plane (g . n < 0, |g_t| < mu |g_n|). `ok` false when
-// the model refused the inputs.
-Vec3 planeDrift(const LocalVibration& v, const Vec3& p, const Vec3& n, double mu,
+// The point-mass drift on a plane with unit normal n loaded by `load` (m/s^2, per unit mass:
+// load . n < 0 presses the mass onto it, its in-plane part must be below mu times that). `ok`
+// false when the model refused the inputs.
+Vec3 planeDrift(const LocalVibration& v, const Vec3& p, const Vec3& n, const Vec3& load, double mu,
                 LocalDriftTable* table, bool* ok) {
   const double w = 2 * kPi * v.frequency;
   Vec3 a = v.amplitude;
@@ -399,8 +400,8 @@ Vec3 planeDrift(const LocalVibration& v, const Vec3& p, const Vec3& n, double mu
     an = -an;
   }
   const Vec3 at = a - an * n;
-  const double gn = -dot(v.gravity, n);  // > 0
-  const Vec3 gt = v.gravity + gn * n;
+  const double gn = -dot(load, n);  // > 0
+  const Vec3 gt = load + gn * n;
   const double at_len = norm(at), gt_len = norm(gt);
   Vec3 e1;
   if (at_len > 1e-12 * norm(a) && at_len > 0) {
@@ -442,11 +443,12 @@ Vec3 localDrift(const LocalVibration& vibration, const Vec3& p, const Vec3& n_ou
   }
   Vec3 drift;
   bool ok = false;
-  if (!use_wall) drift = planeDrift(vibration, p, n_out, mu, table, &ok);
-  if (!ok) {  // walls, overhangs, slopes beyond the friction angle
+  if (!use_wall) drift = planeDrift(vibration, p, n_out, vibration.gravity, mu, table, &ok);
+  if (!ok) {  // walls, overhangs, slopes beyond the friction angle: the face's own drive
     use_wall = true;
-    const Vec3 up = (-1.0 / g) * vibration.gravity;
-    drift = tangentialPart(planeDrift(vibration, p, up, mu, table, &ok), n_out);
+    const double load = std::max(gn, g * std::cos(kWallAngle));
+    drift = planeDrift(vibration, p, n_out, -load * n_out, mu, table, &ok);
+    if (!ok) drift = {};
   }
   if (table) table->countContacts(1, use_wall ? 1 : 0);
   if (wall) *wall = use_wall;
