@@ -175,7 +175,8 @@ std::string lossNote(int parts_lost) {
 }
 
 // Writes <scene>_height.csv: the mean height of the parts (m) against time (s), one column per
-// run (the judge, then each model), from the first seed's series. Throws if it cannot write.
+// run (the judge, then each model), from the first seed's series, and its plot <scene>_height.png
+// (said on stderr when gnuplot fails). Throws if it cannot write the CSV.
 template <class Measured>
 void writeHeightCsv(const DriftModelStudyOptions& o, const std::string& scene,
                     const std::vector<std::pair<int, Measured>>& runs) {
@@ -199,7 +200,21 @@ void writeHeightCsv(const DriftModelStudyOptions& o, const std::string& scene,
     }
     csv << "\n";
   }
-  writeFileAtomically(std::filesystem::path(o.out_dir) / (scene + "_height.csv"), csv.str());
+  const std::filesystem::path out(o.out_dir);
+  writeFileAtomically(out / (scene + "_height.csv"), csv.str());
+  std::ostringstream gp;
+  gp << "set datafile separator ','\nset key top left\nset grid\nset xlabel 'time (s)'\n"
+        "set ylabel 'mean height of the nuts (mm)'\nset title '"
+     << scene << ": mean height against time (full vibration: ODE, friction cone)'\nplot ";
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const int slot = runs[k].first;
+    gp << (k ? ", " : "") << "$data using 1:($" << k + 2 << " * 1000) with lines lw 2 title '"
+       << (slot < 0 ? "full vibration" : kModels[slot]) << "'";
+  }
+  gp << "\n";
+  if (!plotPng(gp.str(), {{"data", csv.str()}}, (out / (scene + "_height.png")).string())) {
+    std::fprintf(stderr, "drift model study: the height plot was not written (gnuplot failed)\n");
+  }
 }
 
 // Writes drift_models.{csv,md,png} for the scenes done so far (after every scene, so a long

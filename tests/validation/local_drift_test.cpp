@@ -280,6 +280,33 @@ TEST(LocalDriftTable, InterpolatesTheExactModel) {
   EXPECT_EQ(table.stats().model_runs, runs);
 }
 
+// A query on grid lines runs only the corners its interpolation weights: a level floor or a
+// wall (s1 = s2 = 0) needs the 4 corners of its (Gamma, tau) square, not the cell's 16, and
+// still matches the exact model.
+TEST(LocalDriftTable, RunsOnlyTheCornersAQueryWeights) {
+  PointMassSettings settings;
+  settings.steps_per_cycle = 2048;
+  LocalDriftTable table(settings);
+  PointMassParams p;
+  p.normal_throw = 1.2137;
+  p.tangential_throw = 2.5311;
+  p.mu = 0.4;
+  const PointMassDrift interpolated = table.drift(p);
+  EXPECT_EQ(table.stats().model_runs, 4);
+  EXPECT_EQ(table.stats().cells_computed, 1);
+  const PointMassDrift exact = pointMassDrift(p, settings);
+  ASSERT_TRUE(exact.valid && interpolated.valid);
+  const double bound =
+      kTableTolerance * std::max(std::abs(exact.along), kTableFloor * p.tangential_throw);
+  EXPECT_NEAR(interpolated.along, exact.along, bound);
+  EXPECT_EQ(interpolated.across, 0.0);
+  // Off the grid line in s1 the same cell fills the 4 corners it lacks on that side.
+  p.slope_along = 0.013;
+  table.drift(p);
+  EXPECT_EQ(table.stats().model_runs, 8);
+  EXPECT_EQ(table.stats().cells_computed, 1);
+}
+
 // The local drift at a contact in world geometry: a plane inclined along an arbitrary heading
 // is a classical straight track when the vibration lies in its vertical plane. A vibration
 // given with the opposite sign (half a period of phase) gives the same drift.
@@ -310,12 +337,12 @@ TEST(LocalDrift, InclinedPlaneInWorldGeometryIsTheClassicalTrack) {
   }
 }
 
-// The wall rule (vibration_drift.hpp, "the face's own drive"): a wall, an overhang or a slope
-// steeper than the friction angle is driven by its own vibration, pressed by
-// q = max(g_n, |g| cos 80 deg), with no in-plane load.
+// The wall rule (vibration_drift.hpp, "walls and overhangs: the face's own drive"): a wall or an
+// overhang is driven by its own vibration, pressed by the part's weight |g|, with no in-plane
+// load; a slope steeper than the friction angle gets the floor's drift projected on it.
 
-// The pressing load of a wall or an overhang (m/s^2): |g| cos(kWallAngle).
-constexpr double kWallLoad = kG * 0.17364817766693041;
+// The pressing load of a wall or an overhang (m/s^2): |g|.
+constexpr double kWallLoad = kG;
 
 // A wall that the vibration moves in its own plane transports nothing: shifting a symmetric
 // in-plane vibration by half a period mirrors it, so the mean velocity under a constant normal
@@ -358,8 +385,8 @@ TEST(LocalDrift, WallMovedInItsOwnPlaneDoesNotDrive) {
 
 // A face the vibration hits obliquely is a classical straight track under the face's own
 // pressing load: a level track (no in-plane load), gravity q, vibration at beta = atan(a_n /
-// a_t) to it. A vertical wall (q = |g| cos 80 deg) hit at 20 and 40 degrees, an overhang facing
-// down, and a 35 degree slope with mu = 0.5 (beyond the friction angle: q = g cos 35 deg).
+// a_t) to it. A vertical wall (q = |g|) hit at 20 and 40 degrees (sliding) and at 30 degrees
+// with a throw number of 2 (hopping), and an overhang facing down.
 TEST(LocalDrift, ObliquelyVibratedFaceIsTheClassicalTrackUnderItsLoad) {
   struct Case {
     const char* what;
@@ -369,12 +396,11 @@ TEST(LocalDrift, ObliquelyVibratedFaceIsTheClassicalTrackUnderItsLoad) {
     double load;  // q (m/s^2)
     double amp;   // |a| (m)
   };
-  const double s35 = std::sin(35 * kDeg), c35 = std::cos(35 * kDeg);
   const Case cases[] = {
-      {"wall, 20 deg", {0, 1, 0}, {1, 0, 0}, 20 * kDeg, kWallLoad, 2e-5},
-      {"wall, 40 deg", {-1, 0, 0}, {0, 0, 1}, 40 * kDeg, kWallLoad, 1e-5},
-      {"overhang, 30 deg", {0, 0, -1}, {0, 1, 0}, 30 * kDeg, kWallLoad, 1.5e-5},
-      {"35 deg slope, 25 deg", {s35, 0, c35}, {0, 1, 0}, 25 * kDeg, kG * c35, 0.0001},
+      {"wall, 20 deg", {0, 1, 0}, {1, 0, 0}, 20 * kDeg, kWallLoad, 1.2e-4},
+      {"wall, 40 deg", {-1, 0, 0}, {0, 0, 1}, 40 * kDeg, kWallLoad, 6e-5},
+      {"wall, 30 deg, hopping", {0, -1, 0}, {0, 0, -1}, 30 * kDeg, kWallLoad, 4e-4},
+      {"overhang, 30 deg", {0, 0, -1}, {0, 1, 0}, 30 * kDeg, kWallLoad, 9e-5},
   };
   for (const Case& k : cases) {
     ClassicalParams c;
@@ -396,11 +422,29 @@ TEST(LocalDrift, ObliquelyVibratedFaceIsTheClassicalTrackUnderItsLoad) {
     EXPECT_NEAR(dot(d, k.along), expected, modelBound(c, expected)) << k.what;
     EXPECT_NEAR(norm(d - dot(d, k.along) * k.along), 0.0, modelBound(c, expected)) << k.what;
   }
-  // A gentle slope (10 degrees < the friction angle) is not a wall.
+}
+
+// A slope steeper than the friction angle (35 degrees, tan 35 = 0.70 > mu = 0.5: the part slides
+// away with or without vibration) gets the horizontal floor's drift (here the classical level
+// track's, along the vibration's horizontal heading) projected on it; a gentle slope (10
+// degrees) is a floor of its own.
+TEST(LocalDrift, SteepSlopeUsesTheFloorDriftProjected) {
+  const double heading = 0.4;
+  const ClassicalParams c = classical(0, 30 * kDeg, 0.6, 0.5);
+  const Vec3 along{std::cos(heading), std::sin(heading), 0};
   LocalVibration v;
-  v.amplitude = {0.0001, 0, 0.0001};
-  bool wall = true;
-  localDrift(v, {}, {std::sin(10 * kDeg), 0, std::cos(10 * kDeg)}, 0.5, nullptr, &wall);
+  v.frequency = c.frequency;
+  v.amplitude = (c.amplitude * std::cos(c.vibration_angle)) * along +
+                Vec3{0, 0, c.amplitude * std::sin(c.vibration_angle)};
+  const double speed = scene::classicalDrift(c).mean_speed;
+  const Vec3 floor = speed * along;
+  const Vec3 n{std::sin(35 * kDeg), 0, std::cos(35 * kDeg)};
+  bool wall = false;
+  const Vec3 d = localDrift(v, {0.3, -0.1, 0.05}, n, c.mu, nullptr, &wall);
+  EXPECT_TRUE(wall);
+  EXPECT_NEAR(norm(d - (floor - dot(floor, n) * n)), 0.0, modelBound(c, speed));
+  wall = true;
+  localDrift(v, {}, {std::sin(10 * kDeg), 0, std::cos(10 * kDeg)}, c.mu, nullptr, &wall);
   EXPECT_FALSE(wall);
 }
 
