@@ -463,4 +463,18 @@ Vec3 localDrift(const LocalVibration& vibration, const Vec3& p, const Vec3& n_ou
   return drift;
 }
 
+double wallFrictionFactor(const LocalVibration& v, const Vec3& p, const Vec3& n_out,
+                          const Vec3& relative_velocity) {
+  const double g = norm(v.gravity);
+  const double gn = -dot(v.gravity, n_out);
+  if (gn > g * std::cos(kWallAngle)) return 1;  // a floor or a steep slope (also NaN: no wall)
+  Vec3 a = v.amplitude;
+  if (v.torsion_amplitude != 0)
+    a = a + v.torsion_amplitude * cross(v.axis_direction, p - v.axis_origin);
+  const double peak = 2 * kPi * v.frequency * norm(tangentialPart(a, n_out));
+  const double speed = norm(tangentialPart(relative_velocity, n_out));
+  if (!(peak > 0) || !std::isfinite(speed) || speed >= peak) return 1;
+  return (2 / kPi) * std::asin(speed / peak);
+}
+
 }  // namespace rheofeed

@@ -448,6 +448,41 @@ TEST(LocalDrift, SteepSlopeUsesTheFloorDriftProjected) {
   EXPECT_FALSE(wall);
 }
 
+// The mean friction of a wall vibrating in its own plane on a part sliding past it: the cycle
+// average of the Coulomb force's direction, sign(V - U sin(w t)), integrated here by the
+// midpoint rule over 200000 points of a cycle (independent of the closed form in the code), for
+// the bowl's wall (screw vibration) and parts sliding at 0 .. 1.2 U along it; floors, steep
+// slopes and U = 0 keep their mu.
+TEST(LocalDrift, WallFrictionFactorIsTheCycleAverageOfCoulombFriction) {
+  LocalVibration bowl;
+  bowl.frequency = 50;
+  bowl.amplitude = {0, 0, 0.00015};
+  bowl.torsion_amplitude = 0.0029670597283903604;
+  const Vec3 p{0.15, 0, 0.03}, n{-1, 0, 0};
+  const Vec3 a = bowl.amplitude + bowl.torsion_amplitude * cross(bowl.axis_direction, p);
+  const double peak = 2 * kPi * bowl.frequency * norm(a);  // a lies in the wall's plane
+  const Vec3 along = (1 / norm(a)) * a;
+  constexpr int kPoints = 200000;
+  for (double ratio : {0.0, 0.05, 0.3, 0.7, 0.99, 1.2}) {
+    double mean = 0;
+    for (int k = 0; k < kPoints; ++k) {
+      const double phase = 2 * kPi * (k + 0.5) / kPoints;
+      const double relative = ratio * peak - peak * std::sin(phase);
+      mean += (relative > 0) - (relative < 0);
+    }
+    mean /= kPoints;
+    // The part also moves normal to the wall and along its normal vibration: only the
+    // tangential part counts.
+    const Vec3 v = (ratio * peak) * along + Vec3{0.01, 0, 0};
+    EXPECT_NEAR(wallFrictionFactor(bowl, p, n, v), mean, 1e-4) << "V / U = " << ratio;
+  }
+  EXPECT_EQ(wallFrictionFactor(bowl, p, {0, 0, 1}, {0.01, 0, 0}), 1.0);  // the floor
+  LocalVibration still = bowl;
+  still.amplitude = {};
+  still.torsion_amplitude = 0;
+  EXPECT_EQ(wallFrictionFactor(still, p, n, {0, 0.01, 0}), 1.0);
+}
+
 TEST(LocalDrift, InvalidInputsAreRefusedWithTheValueNamed) {
   PointMassParams p;
   p.normal_throw = 0.5;

@@ -200,4 +200,21 @@ class LocalDriftTable {
 Vec3 localDrift(const LocalVibration& vibration, const Vec3& p, const Vec3& n_out, double mu,
                 LocalDriftTable* table, bool* wall = nullptr);
 
+/// The mean friction of a wall or an overhang (the faces localDrift drives by their own
+/// vibration) on a part sliding past it, as a factor on the contact's mu (dimensionless, in
+/// [0, 1]). A face oscillating in its own plane with peak speed U = w |a_t(p)| (m/s) rubs a part
+/// that slides past it at a steady speed V (m/s, the part's in-plane velocity relative to the
+/// face's mean position) with Coulomb friction mu N opposing the relative velocity, whose
+/// direction the oscillation turns back and forth; over a cycle (along one line) the mean is
+///     mu N (2 / pi) asin(V / U)   for V < U,   mu N   for V >= U,
+/// the friction a vibrated surface leaves to a slow part (it vanishes for V -> 0). A rheonomic
+/// run gives the face no motion (localDrift: zero drive for a_n = 0), so its friction would act
+/// in full; this factor makes its mean equal to the vibrating face's. `relative_velocity` (m/s,
+/// world) is the part's velocity at the contact point minus the face's mean velocity (its
+/// tangential part is used); `n_out` the unit normal out of the face. Returns 1 for a face that
+/// is no wall or overhang (g_n > |g| cos(kWallAngle)), for U = 0 and for non-finite inputs. The
+/// normal part of the face's vibration (a_n, which modulates the load) is not in it.
+double wallFrictionFactor(const LocalVibration& vibration, const Vec3& p, const Vec3& n_out,
+                          const Vec3& relative_velocity);
+
 }  // namespace rheofeed
