@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "rheofeed/feeder_set.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -233,7 +232,7 @@ struct FeederSet::Impl {
   Sides sides(const dContact& c, const PairCache& pair) const;
   Velocities surfaceVelocities(const dContact& c, const PairCache& pair, const Sides& sd);
   bool feederVelocity(Feeder& f, const dContact& c, bool feeder_is_g1, dBodyID other, const Vec3& p,
-                      const Vec3& n, Vec3& value, double& mu_factor);
+                      const Vec3& n, Vec3& value);
   bool write(dContact& c, Feeder& primary, const Velocities& v);
   void record(const dContact& c, const PairCache& pair, const Sides& sd, const Velocities& v,
               bool driven) noexcept;
@@ -289,7 +288,6 @@ struct FeederSet::Impl::Sides {
 struct FeederSet::Impl::Velocities {
   Vec3 c_first, c_second;
   bool finite = true;
-  double mu_factor = 1;  // local laws' walls: wallFrictionFactor (vibration_drift.hpp)
 };
 
 // Stage 1, lookup: which of the contact's geoms are feeders (cached while the pair repeats).
@@ -329,7 +327,7 @@ FeederSet::Impl::Velocities FeederSet::Impl::surfaceVelocities(const dContact& c
     if (!f) continue;
     Vec3 value;
     if (!feederVelocity(*f, c, f == pair.f1, f == sd.f_first ? sd.b_second : sd.b_first, p, n,
-                        value, out.mu_factor)) {
+                        value)) {
       out.finite = false;
     }
     (f == sd.f_first ? out.c_first : out.c_second) = value;
@@ -345,7 +343,7 @@ FeederSet::Impl::Velocities FeederSet::Impl::surfaceVelocities(const dContact& c
 // or threw. `feeder_is_g1`: the normal n (ODE's, from g2 into g1) points out of the feeder
 // when it is g2. `other`: the body on the other side of the contact (0 if static).
 bool FeederSet::Impl::feederVelocity(Feeder& f, const dContact& c, bool feeder_is_g1, dBodyID other,
-                                     const Vec3& p, const Vec3& n, Vec3& value, double& mu_factor) {
+                                     const Vec3& p, const Vec3& n, Vec3& value) {
   // User functions (field, twist function, profile) run in here: whatever they throw is caught,
   // and the contact is left undriven (no exception may unwind into ODE).
   try {
@@ -363,14 +361,6 @@ bool FeederSet::Impl::feederVelocity(Feeder& f, const dContact& c, bool feeder_i
     value = contactSurfaceVelocity(law, p, n, feeder_is_g1 ? -n : n, c.surface.mu,
                                    law.needsContactSide() ? partEfficiency(other) : 1.0,
                                    carried ? &centre : nullptr);
-    if (other && f.law.localVibration()) {  // a wall's mean friction on the sliding part
-      dVector3 v_part, v_face = {0, 0, 0};
-      dBodyGetPointVel(other, p.x, p.y, p.z, v_part);
-      if (dBodyID own = dGeomGetBody(f.geom)) dBodyGetPointVel(own, p.x, p.y, p.z, v_face);
-      mu_factor =
-          std::min(mu_factor, wallFrictionFactor(*f.law.localVibration(), p, feeder_is_g1 ? -n : n,
-                                                 toVec3(v_part) - toVec3(v_face)));
-    }
     // Non-finite, or beyond what ODE's motion1 can take (motion_law.hpp, Limits): a NaN
     // component, or an inf (also from squares of finite components that overflow), fails the
     // one comparison.
@@ -415,8 +405,7 @@ bool FeederSet::Impl::write(dContact& c, Feeder& primary, const Velocities& v) {
     });
   }
   surf.mode = withFrictionModel(surf.mode, options.friction);
-  if (v.finite && v.mu_factor < 1) surf.mu *= v.mu_factor;  // a vibrating wall's mean friction
-  if (surf.mu == 0 && v.mu_factor == 1) {
+  if (surf.mu == 0) {
     ++primary.stats.zero_friction;
     report(primary, DiagnosticKind::ZeroFriction, [] {
       return std::string(

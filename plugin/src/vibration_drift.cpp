@@ -259,7 +259,7 @@ struct Corner {
 };
 
 // A cell's corners are filled as lookups need them: a corner whose interpolation weight is 0
-// (an input exactly on a grid line, e.g. s1 = s2 = 0 on a level floor or a wall) is not run.
+// (an input exactly on a grid line, e.g. s1 = s2 = 0 on a level floor) is not run.
 struct Cell {
   std::array<Corner, 16> corners;
   std::uint32_t filled = 0;  // bit c: corners[c] computed
@@ -388,10 +388,9 @@ Vec3 anyPerpendicular(const Vec3& n) {
   return (1.0 / norm(e)) * e;
 }
 
-// The point-mass drift on a plane with unit normal n loaded by `load` (m/s^2, per unit mass:
-// load . n < 0 presses the mass onto it, its in-plane part must be below mu times that). `ok`
-// false when the model refused the inputs.
-Vec3 planeDrift(const LocalVibration& v, const Vec3& p, const Vec3& n, const Vec3& load, double mu,
+// The point-mass drift on a gravity-loaded plane (g . n < 0, |g_t| < mu |g_n|). `ok` false when
+// the model refused the inputs.
+Vec3 planeDrift(const LocalVibration& v, const Vec3& p, const Vec3& n, double mu,
                 LocalDriftTable* table, bool* ok) {
   const double w = 2 * kPi * v.frequency;
   Vec3 a = v.amplitude;
@@ -404,8 +403,8 @@ Vec3 planeDrift(const LocalVibration& v, const Vec3& p, const Vec3& n, const Vec
     an = -an;
   }
   const Vec3 at = a - an * n;
-  const double gn = -dot(load, n);  // > 0
-  const Vec3 gt = load + gn * n;
+  const double gn = -dot(v.gravity, n);  // > 0
+  const Vec3 gt = v.gravity + gn * n;
   const double at_len = norm(at), gt_len = norm(gt);
   Vec3 e1;
   if (at_len > 1e-12 * norm(a) && at_len > 0) {
@@ -447,34 +446,15 @@ Vec3 localDrift(const LocalVibration& vibration, const Vec3& p, const Vec3& n_ou
   }
   Vec3 drift;
   bool ok = false;
-  if (!use_wall) drift = planeDrift(vibration, p, n_out, vibration.gravity, mu, table, &ok);
-  if (!ok && gn > g * std::cos(kWallAngle)) {  // steeper than the friction angle: the floor's
-    use_wall = true;                           // drift projected
-    const Vec3 up = (-1.0 / g) * vibration.gravity;
-    drift = tangentialPart(planeDrift(vibration, p, up, vibration.gravity, mu, table, &ok), n_out);
-  }
-  if (!ok) {  // walls and overhangs: the face's own drive, pressed by the part's weight
+  if (!use_wall) drift = planeDrift(vibration, p, n_out, mu, table, &ok);
+  if (!ok) {  // walls, overhangs, slopes beyond the friction angle
     use_wall = true;
-    drift = planeDrift(vibration, p, n_out, -g * n_out, mu, table, &ok);
-    if (!ok) drift = {};
+    const Vec3 up = (-1.0 / g) * vibration.gravity;
+    drift = tangentialPart(planeDrift(vibration, p, up, mu, table, &ok), n_out);
   }
   if (table) table->countContacts(1, use_wall ? 1 : 0);
   if (wall) *wall = use_wall;
   return drift;
-}
-
-double wallFrictionFactor(const LocalVibration& v, const Vec3& p, const Vec3& n_out,
-                          const Vec3& relative_velocity) {
-  const double g = norm(v.gravity);
-  const double gn = -dot(v.gravity, n_out);
-  if (gn > g * std::cos(kWallAngle)) return 1;  // a floor or a steep slope (also NaN: no wall)
-  Vec3 a = v.amplitude;
-  if (v.torsion_amplitude != 0)
-    a = a + v.torsion_amplitude * cross(v.axis_direction, p - v.axis_origin);
-  const double peak = 2 * kPi * v.frequency * norm(tangentialPart(a, n_out));
-  const double speed = norm(tangentialPart(relative_velocity, n_out));
-  if (!(peak > 0) || !std::isfinite(speed) || speed >= peak) return 1;
-  return (2 / kPi) * std::asin(speed / peak);
 }
 
 }  // namespace rheofeed

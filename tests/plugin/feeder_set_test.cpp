@@ -503,39 +503,4 @@ TEST_F(HandMadeContacts, RecordOfAContactLeftUndrivenByABadLawImposesNothing) {
   EXPECT_TRUE(isFinite(set.slip(set.records()[0])));
 }
 
-// ---------------------------------------------------------------------------------------------
-// The local law's walls (vibration_drift.hpp): no drive from a wall the vibration moves in its
-// own plane, and its friction scaled to the vibrating wall's mean (wallFrictionFactor).
-
-TEST_F(HandMadeContacts, LocalLawWallIsUndrivenWithTheVibratingWallsMeanFriction) {
-  LocalVibration v;
-  v.frequency = 50;
-  v.amplitude = {0.0004, 0, 0};  // along the wall: U = 2 pi 50 0.4 mm = 0.126 m/s
-  FeederSet set;
-  set.add(static_feeder_, MotionLaw::localVibration(v));
-  const Vec3 p{0, 0.5, 0}, n_out{0, 1, 0};  // the wall faces +y; the part is on that side
-  dBodySetPosition(dGeomGetBody(part_), 0, 0.6, 0);
-  for (double speed : {0.0, 0.02, 0.1, 0.2}) {
-    dBodySetLinearVel(dGeomGetBody(part_), speed, 0, 0.003);  // sliding along it, and lifting
-    for (bool feeder_g1 : {true, false}) {
-      // ODE's normal points from g2 into g1.
-      dContact c = feeder_g1 ? contact(static_feeder_, part_, p, -1.0 * n_out)
-                             : contact(part_, static_feeder_, p, n_out);
-      set.beginStep(0.0, 0.01);
-      ASSERT_EQ(set.driveContacts(&c, 1), 1);
-      // No drive but the point-mass model's own rounding (its claimed accuracy: 1 % of 2 % of
-      // the peak in-plane speed, vibration_drift.hpp).
-      const double peak = 2 * kPi * 50 * 0.0004;
-      if (c.surface.mode & dContactMotion1) EXPECT_LT(c.surface.motion1, 2e-4 * peak);
-      const double expected = 0.5 * wallFrictionFactor(v, p, n_out, {speed, 0, 0.003});
-      EXPECT_NEAR(c.surface.mu, expected, kRoundOff) << "speed " << speed;
-      if (speed >= 0.2) EXPECT_EQ(c.surface.mu, 0.5);  // faster than the wall: full friction
-    }
-  }
-  // A floor contact keeps its mu.
-  dContact floor = contact(part_, static_feeder_, p, {0, 0, 1});
-  set.beginStep(0.0, 0.01);
-  ASSERT_EQ(set.driveContacts(&floor, 1), 1);
-  EXPECT_EQ(floor.surface.mu, 0.5);
-}
 }  // namespace rheofeed::test

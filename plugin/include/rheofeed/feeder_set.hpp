@@ -35,11 +35,7 @@
 ///     (mu then is a friction coefficient, not a force in newtons),
 ///   - the friction model of Options::friction: dContactFrictionCone set (cone, patched ODE)
 ///     or cleared (pyramid, ODE's own).
-/// The normal row (depth, ERP/CFM, bounce, motionN) is never touched. One change to friction:
-/// on a wall or an overhang of a local vibration law (vibration_drift.hpp) `mu` is multiplied by
-/// wallFrictionFactor of the other body's velocity there (relative to the feeder's body, if it
-/// has one), in [0, 1]: the mean friction of a wall that vibrates in its own plane on a part
-/// sliding past it, which the stationary wall of a rheonomic run would otherwise apply in full.
+/// The normal row (depth, ERP/CFM, bounce, motionN) is never touched.
 ///
 /// ## Attach order
 /// `node0` is decided as ODE does it: the joint is assumed attached as

@@ -37,40 +37,20 @@
 /// repeats twice (period 1 to 8) or, for chaotic hopping, averaged over the last cycles. Its
 /// error is first order in the step (PointMassSettings::steps_per_cycle says how large).
 ///
-/// ## Walls and overhangs: the face's own drive; steep slopes
-/// Where gravity does not hold the mass on the plane (g_n <= |g| cos(kWallAngle): a wall or an
-/// overhang), something else carries the part's weight (a floor, a ramp, other parts) and the
-/// face only rubs on it. Its drive is then the point-mass drift of the face's own local
-/// vibration a(p), with the part pressed onto the face by a load q per unit mass and no
-/// in-plane load:
-///     Gamma = |a_n| w^2 / q,  tau = |a_t| w^2 / q,  s1 = s2 = 0,  drift = (q / w) (V1 e1 + V2 e2).
-/// The law cannot know the load when the contact is made (a part leaning on the wall, a track
-/// tilted towards it, parts pushing from behind): it takes the part's weight, q = |g|. The load
-/// matters only where the vibration has a component normal to the face (a lighter load would
-/// throw the part harder). Where the vibration moves the face in its own plane (a_n = 0: a
-/// bowl's cylindrical wall under screw vibration about the bowl's axis, a trough's side rails
-/// under a vibration in the plane of the track's axis) the drive is zero at any load: a
-/// symmetric in-plane vibration under a constant normal load transports nothing (shifting the
-/// motion by half a period mirrors it), so the face holds back a part sliding past it with
-/// friction, as the vibrating face does. (Until issue 18 walls got the floor's drift projected
-/// on them: a bowl wall carried a nut leaning on it with its face at the floor's drift.)
-///
-/// A face steeper than the friction angle (|g_t| >= mu |g_n|: the mass slides away with or
-/// without vibration, no steady drift exists) gets the drift of a horizontal surface (n = -g /
-/// |g|) at the same point, projected on the face. (Its own drive under its gravity load was
-/// tried: contacts on box edges and tilted parts give such faces every orientation, which
-/// spread the drift table over thousands of cells - 2637 cells, real-time factor 2.2 on the
-/// primitive bowl against 1231 and 0.85 with the projection.)
-///
-/// LocalDriftStats counts the contacts of both rules.
+/// ## Where the model does not apply: walls, overhangs, steep slopes
+/// Where gravity does not hold the mass on the plane (g_n >= -|g| cos(kWallAngle)) or the plane
+/// is steeper than the friction angle (|g_t| >= mu |g_n|: the mass slides away with or without
+/// vibration, no steady drift exists), the local law uses the drift of a horizontal surface (n =
+/// -g / |g|) at the same point, projected on the contact plane: a side rail or a bowl wall then
+/// neither brakes nor pushes a part that the floor drives. LocalDriftStats counts these
+/// contacts.
 ///
 /// ## Cost
 /// pointMassDrift takes milliseconds (PointMassSettings). LocalDriftTable fills a grid in
 /// (Gamma, tau, s1, s2) lazily, the corners of a cell (up to 16) as contacts need them, and
 /// interpolates multilinearly in the cell (a corner of weight 0 - an input on a grid line, as
-/// s1 = s2 = 0 on a level floor or a wall - is not run); a contact whose inputs equal the previous
-/// contact's (every contact of a translating flat feeder) reuses the previous result. Units SI
-/// throughout.
+/// s1 = s2 = 0 on a level floor - is not run); a contact whose inputs equal the previous contact's
+/// (every contact of a translating flat feeder) reuses the previous result. Units SI throughout.
 #pragma once
 
 #include <cstdint>
@@ -156,16 +136,14 @@ struct LocalVibration {
 };
 
 /// Walls: a contact plane whose outward normal is within this angle (rad) of horizontal, or
-/// faces down, is driven by its own vibration under the part's weight (file comment). 80
-/// degrees.
+/// faces down, uses the horizontal surface's drift (file comment). 80 degrees.
 constexpr double kWallAngle = 1.3962634015954636;
 
 /// Counts of a local law's contacts (for reporting).
 struct LocalDriftStats {
   std::int64_t contacts = 0;        ///< contacts driven
-  std::int64_t wall_contacts = 0;   ///< of which were walls or overhangs (the face's own
-                                    ///< drive) or steeper than the friction angle (the floor's
-                                    ///< drift projected)
+  std::int64_t wall_contacts = 0;   ///< of which used the horizontal surface's drift (walls,
+                                    ///< overhangs, steeper than the friction angle)
   std::int64_t cells_computed = 0;  ///< table cells filled
   std::int64_t model_runs = 0;      ///< pointMassDrift calls (grid corners)
 };
@@ -194,27 +172,10 @@ class LocalDriftTable {
 
 /// The local drift velocity (m/s, world, in the contact plane) at contact point `p` (m, world)
 /// with unit normal `n_out` pointing out of the feeder into the part, friction `mu`: the
-/// point-mass drift of `vibration` there times vibration.efficiency (walls, overhangs and steep
-/// slopes: file comment). `table` may be null (exact model, milliseconds per call). `wall`
-/// (optional) is set for walls, overhangs and steep slopes.
+/// point-mass drift of `vibration` there times vibration.efficiency (walls and steep slopes: file
+/// comment). `table` may be null (exact model, milliseconds per call). `wall` (optional) is set
+/// when the horizontal surface's drift was used.
 Vec3 localDrift(const LocalVibration& vibration, const Vec3& p, const Vec3& n_out, double mu,
                 LocalDriftTable* table, bool* wall = nullptr);
-
-/// The mean friction of a wall or an overhang (the faces localDrift drives by their own
-/// vibration) on a part sliding past it, as a factor on the contact's mu (dimensionless, in
-/// [0, 1]). A face oscillating in its own plane with peak speed U = w |a_t(p)| (m/s) rubs a part
-/// that slides past it at a steady speed V (m/s, the part's in-plane velocity relative to the
-/// face's mean position) with Coulomb friction mu N opposing the relative velocity, whose
-/// direction the oscillation turns back and forth; over a cycle (along one line) the mean is
-///     mu N (2 / pi) asin(V / U)   for V < U,   mu N   for V >= U,
-/// the friction a vibrated surface leaves to a slow part (it vanishes for V -> 0). A rheonomic
-/// run gives the face no motion (localDrift: zero drive for a_n = 0), so its friction would act
-/// in full; this factor makes its mean equal to the vibrating face's. `relative_velocity` (m/s,
-/// world) is the part's velocity at the contact point minus the face's mean velocity (its
-/// tangential part is used); `n_out` the unit normal out of the face. Returns 1 for a face that
-/// is no wall or overhang (g_n > |g| cos(kWallAngle)), for U = 0 and for non-finite inputs. The
-/// normal part of the face's vibration (a_n, which modulates the load) is not in it.
-double wallFrictionFactor(const LocalVibration& vibration, const Vec3& p, const Vec3& n_out,
-                          const Vec3& relative_velocity);
 
 }  // namespace rheofeed

@@ -130,8 +130,8 @@ struct RunHealth {
   double max_speed_ratio = 0;
   /// Rheonomic runs: feeders driven by the local vibration law (DriftModel local or
   /// local_sampled; 0 when none), and that law's counts summed over them since the start
-  /// (MotionLaw::localStats): contacts driven, of which walls (walls and overhangs: the
-  /// face's own drive; slopes beyond the friction angle), drift table cells filled and
+  /// (MotionLaw::localStats): contacts driven, of which walls (the horizontal surface's drift
+  /// used: walls, overhangs, slopes beyond the friction angle), drift table cells filled and
   /// point-mass model runs. Informative, not a loss: not part of anything().
   int local_law_feeders = 0;
   LocalDriftStats local_law;
