@@ -52,6 +52,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(100, 100000));
   app.add_option("--bowl-scene", dm.bowl_scene, "--drift-models: the bowl's scene file")
       ->capture_default_str();
+  app.add_option("--bowl-primitives-scene", dm.bowl_primitives_scene,
+                 "--drift-models: the bowl of primitives' scene file (scene bowl_primitives)")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (drift_models) {
     dm.out_dir = options.out_dir;

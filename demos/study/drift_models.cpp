@@ -17,6 +17,7 @@
 #include "rheofeed/output/plot.hpp"
 #include "rheofeed/scene/run_step.hpp"
 #include "rheofeed/scene/scene_io.hpp"
+#include "study/bowl_phases.hpp"
 
 namespace rheofeed::demo {
 namespace {
@@ -28,9 +29,12 @@ constexpr double kDeg = kPi / 180;
 // The drift models of the comparison, in table order.
 // "level_constant": the sampled constant of track_level reused on the other tracks (what a user
 // who calibrated once on a level track gets on an incline or a cross slope).
-const char* const kModels[] = {"local", "local_sampled", "sampled_constant", "classical",
-                               "level_constant"};
-constexpr int kModelCount = 5;
+// "scene_constant": the constant drift twist the scene file ships (the primitive bowl's, carried
+// over from the mesh bowl).
+const char* const kModels[] = {"local",     "local_sampled",  "sampled_constant",
+                               "classical", "level_constant", "scene_constant"};
+constexpr int kModelCount = 6;
+constexpr int kSceneConstant = 5;
 
 // A scene of the comparison: how to build it, what its drift is measured as.
 struct StudyScene {
@@ -46,6 +50,18 @@ struct StudyScene {
   // machine; 200 is twice the bowl scene's own full-vibration step.
   int judge_steps_per_cycle = 0;
 };
+
+// The bowl of primitives is measured per bowl phase (bowl_phases.hpp): one table row per phase,
+// and the mean height against time. Its judge solves the friction cone, and only the local law
+// and the scene's own constant run (no sampling run: the question).
+const char* const kBowlPrimitives = "bowl_primitives";
+bool byBowlPhase(const StudyScene& s) {
+  return s.name == kBowlPrimitives;
+}
+bool modelRuns(const StudyScene& s, int model) {
+  if (byBowlPhase(s)) return model == 0 || model == kSceneConstant;
+  return model != kSceneConstant;
+}
 
 std::vector<StudyScene> studyScenes(const DriftModelStudyOptions& o) {
   std::vector<StudyScene> list;
@@ -94,6 +110,20 @@ std::vector<StudyScene> studyScenes(const DriftModelStudyOptions& o) {
   list.push_back({"bowl_ramp", "bowl, 12 nuts on the ramp, 8-20 s (rad/s)",
                   [=](bool quick) { return bowl_phase("bowl_ramp", 8.0, 20.0, quick); }, false,
                   200});
+  // The bowl of primitives over its whole run (60 s: the nuts reach the ramp's second turn at
+  // the calibrated drift), measured by where each nut is. Judge at the scene file's own
+  // full-vibration step (the shipped file: 100 steps per cycle; 60 s take about 90 s CPU).
+  const std::string primitives = o.bowl_primitives_scene;
+  list.push_back({kBowlPrimitives,
+                  "bowl of primitives, 12 cylinder nuts, 1-60 s, by where each nut is (rad/s)",
+                  [primitives](bool quick) {
+                    Scene s = loadScene(primitives);
+                    s.name = "bowl_primitives";
+                    if (quick) s.duration = 6.0;
+                    s.outputs.warmup = 1.0;
+                    return s;
+                  },
+                  false, 0});
   return list;
 }
 
@@ -115,12 +145,24 @@ struct ModelResult {
 
 struct SceneResult {
   std::string name, what;
+  double part_seconds = 0;  // bowl phases: the judge's part-seconds in the phase
   Method judge = Method::OdeFullVibration;
   int judge_steps_per_cycle = 0;
   double reference = 0, reference_ci95 = 0, reference_cpu = 0;
   int reference_parts_lost = 0;
   ModelResult models[kModelCount];
 };
+
+// What a phase's drift is made of: time in it, stalled windows, drift while moving.
+std::string phaseNote(const PhaseDrift& d) {
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "%.0f part-seconds, %.0f %% of %d windows of %.0f s stalled (< %.2g rad/s), "
+                "moving at %.4g rad/s",
+                d.part_seconds, 100 * d.stalled_share, d.windows, kStallWindow, kStallDrift,
+                d.moving_drift);
+  return text;
+}
 
 Scene withDriftModel(Scene s, int fixture, DriftModel model) {
   s.fixtures[static_cast<std::size_t>(fixture)].law.drift_model = model;
@@ -130,6 +172,49 @@ Scene withDriftModel(Scene s, int fixture, DriftModel model) {
 std::string lossNote(int parts_lost) {
   if (parts_lost == 0) return "";
   return " (" + std::to_string(parts_lost) + " parts lost)";
+}
+
+// Writes <scene>_height.csv: the mean height of the parts (m) against time (s), one column per
+// run (the judge, then each model), from the first seed's series, and its plot <scene>_height.png
+// (said on stderr when gnuplot fails). Throws if it cannot write the CSV.
+template <class Measured>
+void writeHeightCsv(const DriftModelStudyOptions& o, const std::string& scene,
+                    const std::vector<std::pair<int, Measured>>& runs) {
+  std::ostringstream csv;
+  csv << "time_s";
+  std::size_t rows = 0;
+  for (const auto& [slot, m] : runs) {
+    csv << "," << (slot < 0 ? "full_vibration" : kModels[slot]) << "_m";
+    rows = std::max(rows, m.series.size());
+  }
+  csv << "\n";
+  char cell[64];
+  for (std::size_t i = 0; i < rows; ++i) {
+    std::snprintf(cell, sizeof cell, "%.4f",
+                  runs.front().second.series.size() > i ? runs.front().second.series[i].time : NAN);
+    csv << cell;
+    for (const auto& run : runs) {
+      const auto& series = run.second.series;
+      std::snprintf(cell, sizeof cell, ",%.6f", i < series.size() ? series[i].mean_height : NAN);
+      csv << cell;
+    }
+    csv << "\n";
+  }
+  const std::filesystem::path out(o.out_dir);
+  writeFileAtomically(out / (scene + "_height.csv"), csv.str());
+  std::ostringstream gp;
+  gp << "set datafile separator ','\nset key top left\nset grid\nset xlabel 'time (s)'\n"
+        "set ylabel 'mean height of the nuts (mm)'\nset title '"
+     << scene << ": mean height against time (full vibration: ODE, friction cone)'\nplot ";
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const int slot = runs[k].first;
+    gp << (k ? ", " : "") << "$data using 1:($" << k + 2 << " * 1000) with lines lw 2 title '"
+       << (slot < 0 ? "full vibration" : kModels[slot]) << "'";
+  }
+  gp << "\n";
+  if (!plotPng(gp.str(), {{"data", csv.str()}}, (out / (scene + "_height.png")).string())) {
+    std::fprintf(stderr, "drift model study: the height plot was not written (gnuplot failed)\n");
+  }
 }
 
 // Writes drift_models.{csv,md,png} for the scenes done so far (after every scene, so a long
@@ -149,13 +234,16 @@ bool writeOutputs(const DriftModelStudyOptions& o, const std::vector<SceneResult
         "full vibration) / |full vibration|. Cost = CPU of the run plus "
         "its calibration (sampling runs at the judge's steps per cycle).\n\n"
      << "| scene | full vibration | local | local + sampled efficiency | sampled constant | "
-        "classical constant | constant sampled on the level track "
-        "|\n|---|---|---|---|---|---|---|\n";
-  bars << "scene,local,local_sampled,sampled_constant,classical,level_constant\n";
+        "classical constant | constant sampled on the level track | the scene's own constant "
+        "|\n|---|---|---|---|---|---|---|---|\n";
+  bars << "scene,local,local_sampled,sampled_constant,classical,level_constant,scene_constant\n";
   char line[512];
   for (const SceneResult& r : results) {
     std::snprintf(line, sizeof line, "| %s | %.4g (%s, %d steps/cycle, %.0f s) |", r.name.c_str(),
-                  r.reference, r.judge == Method::OdeFullVibration ? "ODE" : "reference",
+                  r.reference,
+                  r.judge != Method::OdeFullVibration ? "reference"
+                  : r.part_seconds > 0                ? "ODE, cone"
+                                                      : "ODE",
                   r.judge_steps_per_cycle, r.reference_cpu);
     md << line;
     bars << r.name;
@@ -185,6 +273,11 @@ bool writeOutputs(const DriftModelStudyOptions& o, const std::vector<SceneResult
     md << "- " << r.name << ": " << r.what;
     if (!r.models[1].note.empty()) md << "; local_sampled: " << r.models[1].note;
     if (!r.models[3].ran && !r.models[3].note.empty()) md << "; classical: " << r.models[3].note;
+    if (r.part_seconds > 0) {  // bowl phases: every model's phase note
+      for (int k : {0, kSceneConstant}) {
+        if (r.models[k].ran) md << "; " << kModels[k] << ": " << r.models[k].note;
+      }
+    }
     md << "\n";
   }
   const std::filesystem::path out(o.out_dir);
@@ -206,7 +299,8 @@ bool writeOutputs(const DriftModelStudyOptions& o, const std::vector<SceneResult
         "0.1 ? $3 : 0.1) skip 1 title 'local + sampled efficiency', '' using ($4 > 0.1 ? $4 : "
         "0.1) skip 1 title 'sampled constant', '' using ($5 > 0.1 ? $5 : 0.1) skip 1 title "
         "'classical constant', '' using ($6 > 0.1 ? $6 : 0.1) skip 1 title 'level-track "
-        "constant on this scene'\n";
+        "constant on this scene', '' using ($7 > 0.1 ? $7 : 0.1) skip 1 title 'the scene''s "
+        "own constant'\n";
   if (!plotPng(gp.str(), {{"data", bars.str()}}, (out / "drift_models.png").string())) {
     std::fprintf(stderr, "drift model study: the plot was not written (gnuplot failed)\n");
   }
@@ -263,9 +357,12 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
       std::fprintf(stderr, "\n== %s: %s\n", entry.name.c_str(), entry.what.c_str());
 
       // The judge: full vibration at the finest step, over the seeds.
-      const int ref_spc = entry.judge_steps_per_cycle > 0 ? entry.judge_steps_per_cycle
-                          : o.quick                       ? 400
-                                                          : o.reference_steps_per_cycle;
+      // The primitive bowl's judge steps with its scene file's solver.time_step.
+      const int ref_spc = byBowlPhase(entry) ? static_cast<int>(std::lround(
+                                                   1.0 / (f * scene.solver.time_step)))
+                          : entry.judge_steps_per_cycle > 0 ? entry.judge_steps_per_cycle
+                          : o.quick                         ? 400
+                                                            : o.reference_steps_per_cycle;
       r.judge_steps_per_cycle = ref_spc;
       // The scene's own rheonomic step where it gives one (the bowl: 0.005 s, its trimesh
       // floor lets nuts tunnel at 0.01 s), else the study's.
@@ -275,26 +372,58 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
       const Method judge =
           entry.reference_judge ? Method::ReferenceFullVibration : Method::OdeFullVibration;
       r.judge = judge;
+      // Every run of this scene: the mean drift over the seeds (the first seed's CI), and for
+      // the bowl phases each phase's drift and the first seed's series and nut trace.
+      struct Measured {
+        PhaseDrift phases[kBowlPhaseCount];
+        std::vector<DriftSample> series;
+      };
+      // By run: -1 the judge, else the model's index in kModels.
+      std::vector<std::pair<int, Measured>> phased;
       auto mean_over_seeds = [&](const Scene& base, Method method, const std::string& label,
-                                 double* ci, double* cpu, int* parts_lost) {
+                                 int slot, double* ci, double* cpu, int* parts_lost) {
         double sum = 0;
+        Measured measured;
         for (int k = 0; k < o.seeds; ++k) {
           Scene s = base;
           s.seed = base.seed + static_cast<std::uint64_t>(k);
-          const RunMetrics m = measureRun(s, method, stderrProgress(label));
+          BowlPhaseObserver phases(s.outputs.warmup, k == 0);
+          std::vector<scene::RunObserver*> observers;
+          if (byBowlPhase(entry)) observers.push_back(&phases);
+          const RunMetrics m = measureRun(s, method, stderrProgress(label), observers);
           sum += m.mean_drift;
           *cpu += m.cpu_seconds;
           if (k == 0) *ci = m.mean_drift_ci95;
           *parts_lost += m.health.partsLost();
+          if (!byBowlPhase(entry)) continue;
+          for (int p = 0; p < kBowlPhaseCount; ++p) {
+            const PhaseDrift d = phases.drift(static_cast<BowlPhase>(p));
+            measured.phases[p].drift += d.drift / o.seeds;
+            measured.phases[p].part_seconds += d.part_seconds;
+            measured.phases[p].parts += d.parts;
+            measured.phases[p].stalled_share += d.stalled_share / o.seeds;
+            measured.phases[p].moving_drift += d.moving_drift / o.seeds;
+            measured.phases[p].windows += d.windows;
+            if (k == 0) measured.phases[p].ci95 = d.ci95;
+          }
+          if (k == 0) {
+            measured.series = m.series;
+            const std::string run = slot < 0 ? "full_vibration" : kModels[slot];
+            writeFileAtomically(
+                std::filesystem::path(o.out_dir) / (entry.name + "_trace_" + run + ".csv"),
+                "time_s,part,x_m,y_m,z_m,phase\n" + phases.trace());
+          }
         }
+        if (byBowlPhase(entry)) phased.emplace_back(slot, measured);
         return sum / o.seeds;
       };
       {
         Scene s = scene;
         s.solver.time_step = 1.0 / (f * ref_spc);
+        if (byBowlPhase(entry)) s.solver.friction = FrictionModel::Cone;
         r.reference = mean_over_seeds(
             s, judge, entry.name + " full vibration " + std::to_string(ref_spc) + " steps/cycle",
-            &r.reference_ci95, &r.reference_cpu, &r.reference_parts_lost);
+            -1, &r.reference_ci95, &r.reference_cpu, &r.reference_parts_lost);
       }
       std::fprintf(stderr, "%s: full vibration %.6g +- %.2g (%.1f s CPU)%s\n", entry.name.c_str(),
                    r.reference, r.reference_ci95, r.reference_cpu,
@@ -306,14 +435,15 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
         run.solver.time_step = h_rheonomic;
         run.outputs.sample_interval = std::max(h_rheonomic, scene.outputs.sample_interval);
         ModelResult& m = r.models[k];
-        m.drift = mean_over_seeds(run, Method::OdeRheonomic, entry.name + " " + kModels[k], &m.ci95,
-                                  &m.run_cpu, &m.parts_lost);
+        m.drift = mean_over_seeds(run, Method::OdeRheonomic, entry.name + " " + kModels[k], k,
+                                  &m.ci95, &m.run_cpu, &m.parts_lost);
         m.ran = true;
         std::fprintf(stderr, "%s: %s %.6g (%+.1f %%)%s\n", entry.name.c_str(), kModels[k], m.drift,
                      100 * (m.drift - r.reference) / std::abs(r.reference),
                      lossNote(m.parts_lost).c_str());
       };
       auto attempt = [&](int k, const std::function<void()>& body) {
+        if (!modelRuns(entry, k)) return;
         try {
           body();
         } catch (const std::exception& e) {
@@ -357,7 +487,35 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
         r.models[3].calibration_cpu = c.cpu_seconds;
         rheonomic(3, withCalibration(scene, c));
       });
-      results.push_back(r);
+      attempt(kSceneConstant, [&] {
+        rheonomic(kSceneConstant, withDriftModel(scene, fixture, DriftModel::CalibratedDrift));
+      });
+      if (byBowlPhase(entry)) {
+        // One row per phase: the judge's phase drift against each model's.
+        for (BowlPhase phase : {BowlPhase::Floor, BowlPhase::Ramp}) {
+          const auto p = static_cast<std::size_t>(phase);
+          SceneResult row = r;
+          row.name = r.name + "_" + toString(phase);
+          row.what = r.what + ", " + toString(phase) + " phase";
+          const PhaseDrift& judged = phased.front().second.phases[p];  // the judge runs first
+          row.reference = judged.drift;
+          row.reference_ci95 = judged.ci95;
+          row.part_seconds = judged.part_seconds;
+          row.what += "; full vibration: " + phaseNote(judged);
+          for (const auto& [slot, measured] : phased) {
+            if (slot < 0) continue;
+            const int k = slot;
+            const PhaseDrift& d = measured.phases[p];
+            row.models[k].drift = d.drift;
+            row.models[k].ci95 = d.ci95;
+            row.models[k].note += (row.models[k].note.empty() ? "" : "; ") + phaseNote(d);
+          }
+          results.push_back(row);
+        }
+        writeHeightCsv(o, entry.name, phased);
+      } else {
+        results.push_back(r);
+      }
       if (!writeOutputs(o, results, false)) return 2;
     }
   } catch (const std::exception& e) {

@@ -258,9 +258,11 @@ struct Corner {
   bool valid = false;
 };
 
+// A cell's corners are filled as lookups need them: a corner whose interpolation weight is 0
+// (an input exactly on a grid line, e.g. s1 = s2 = 0 on a level floor) is not run.
 struct Cell {
   std::array<Corner, 16> corners;
-  bool valid = false;  // all corners valid
+  std::uint32_t filled = 0;  // bit c: corners[c] computed
 };
 
 }  // namespace
@@ -338,26 +340,28 @@ PointMassDrift LocalDriftTable::drift(const PointMassParams& p) {
     key.mu = bitsOf(p.mu);
     auto it = s.cells.find(key);
     if (it == s.cells.end()) {
-      Cell cell;
-      cell.valid = true;
-      for (int c = 0; c < 16; ++c) {
+      ++s.stats.cells_computed;
+      it = s.cells.emplace(key, Cell{}).first;
+    }
+    Cell& cell = it->second;
+    bool valid = true;
+    double v1 = 0, v2 = 0;
+    for (int c = 0; c < 16 && valid; ++c) {
+      double w = 1;
+      for (int d = 0; d < 4; ++d) w *= ((c >> d) & 1) ? frac[d] : 1 - frac[d];
+      if (w == 0) continue;
+      const auto k = static_cast<std::size_t>(c);
+      if (!((cell.filled >> c) & 1u)) {
         CornerKey ck = key;
         for (int d = 0; d < 4; ++d) ck.i[d] += (c >> d) & 1;
-        cell.corners[static_cast<std::size_t>(c)] = s.corner(ck, p.mu);
-        cell.valid = cell.valid && cell.corners[static_cast<std::size_t>(c)].valid;
+        cell.corners[k] = s.corner(ck, p.mu);
+        cell.filled |= 1u << c;
       }
-      ++s.stats.cells_computed;
-      it = s.cells.emplace(key, cell).first;
+      valid = cell.corners[k].valid;
+      v1 += w * cell.corners[k].v1;
+      v2 += w * cell.corners[k].v2;
     }
-    const Cell& cell = it->second;
-    if (cell.valid) {
-      double v1 = 0, v2 = 0;
-      for (int c = 0; c < 16; ++c) {
-        double w = 1;
-        for (int d = 0; d < 4; ++d) w *= ((c >> d) & 1) ? frac[d] : 1 - frac[d];
-        v1 += w * cell.corners[static_cast<std::size_t>(c)].v1;
-        v2 += w * cell.corners[static_cast<std::size_t>(c)].v2;
-      }
+    if (valid) {
       result.along = v1;
       result.across = v2;
       result.valid = true;

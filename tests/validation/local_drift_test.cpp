@@ -280,6 +280,33 @@ TEST(LocalDriftTable, InterpolatesTheExactModel) {
   EXPECT_EQ(table.stats().model_runs, runs);
 }
 
+// A query on grid lines runs only the corners its interpolation weights: a level floor
+// (s1 = s2 = 0) needs the 4 corners of its (Gamma, tau) square, not the cell's 16, and still
+// matches the exact model.
+TEST(LocalDriftTable, RunsOnlyTheCornersAQueryWeights) {
+  PointMassSettings settings;
+  settings.steps_per_cycle = 2048;
+  LocalDriftTable table(settings);
+  PointMassParams p;
+  p.normal_throw = 1.2137;
+  p.tangential_throw = 2.5311;
+  p.mu = 0.4;
+  const PointMassDrift interpolated = table.drift(p);
+  EXPECT_EQ(table.stats().model_runs, 4);
+  EXPECT_EQ(table.stats().cells_computed, 1);
+  const PointMassDrift exact = pointMassDrift(p, settings);
+  ASSERT_TRUE(exact.valid && interpolated.valid);
+  const double bound =
+      kTableTolerance * std::max(std::abs(exact.along), kTableFloor * p.tangential_throw);
+  EXPECT_NEAR(interpolated.along, exact.along, bound);
+  EXPECT_EQ(interpolated.across, 0.0);
+  // Off the grid line in s1 the same cell fills the 4 corners it lacks on that side.
+  p.slope_along = 0.013;
+  table.drift(p);
+  EXPECT_EQ(table.stats().model_runs, 8);
+  EXPECT_EQ(table.stats().cells_computed, 1);
+}
+
 // The local drift at a contact in world geometry: a plane inclined along an arbitrary heading
 // is a classical straight track when the vibration lies in its vertical plane. A vibration
 // given with the opposite sign (half a period of phase) gives the same drift.

@@ -47,8 +47,9 @@
 ///
 /// ## Cost
 /// pointMassDrift takes milliseconds (PointMassSettings). LocalDriftTable fills a grid in
-/// (Gamma, tau, s1, s2) lazily, one cell (16 corners) at a time as contacts need it, and
-/// interpolates multilinearly in the cell; a contact whose inputs equal the previous contact's
+/// (Gamma, tau, s1, s2) lazily, the corners of a cell (up to 16) as contacts need them, and
+/// interpolates multilinearly in the cell (a corner of weight 0 - an input on a grid line, as
+/// s1 = s2 = 0 on a level floor - is not run); a contact whose inputs equal the previous contact's
 /// (every contact of a translating flat feeder) reuses the previous result. Units SI throughout.
 #pragma once
 
@@ -156,8 +157,9 @@ class LocalDriftTable {
   LocalDriftTable(const LocalDriftTable&) = delete;
   LocalDriftTable& operator=(const LocalDriftTable&) = delete;
 
-  /// The interpolated (V1, V2) at `params` (file comment; units |g_n| / w). valid = false where
-  /// a corner of the cell is outside the model (then the exact model is tried at the point).
+  /// The interpolated (V1, V2) at `params` (file comment; units |g_n| / w). Where a corner the
+  /// interpolation weights is outside the model, the exact model is tried at the point (valid =
+  /// false when that refuses it too).
   PointMassDrift drift(const PointMassParams& params);
   LocalDriftStats stats() const;
   /// Adds to the contact counts of stats() (localDrift and the callers' caches count here).
