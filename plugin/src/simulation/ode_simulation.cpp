@@ -238,8 +238,11 @@ class OdeSimulation final : public PartSimulation {
       const bool f1 = isFixture(j.g1), f2 = isFixture(j.g2);
       if (f1 == f2 || !j.feedback) continue;  // part-part or fixture-fixture
       const dGeomID part = f1 ? j.g2 : j.g1;
-      const dBodyID body = dGeomGetBody(part);
-      const dReal* f = dJointGetBody(j.joint, 0) == body ? j.feedback->f1 : j.feedback->f2;
+      // f1 acts on the joint's first body (Joint::first_body_is_g1 says whose), which is the
+      // part whenever the fixture has no body; dJointGetBody(joint, 0) would not do: on a joint
+      // attached with a null first body it returns that null, whose f2 is zero.
+      const bool f1_on_part = (part == j.g1) == j.first_body_is_g1;
+      const dReal* f = f1_on_part ? j.feedback->f1 : j.feedback->f2;
       const Vec3 impulse = h * toVec3(f);
       const Vec3 n_into_part = part == j.g1 ? j.normal : -j.normal;
       ++totals.count;
