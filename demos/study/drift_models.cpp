@@ -358,8 +358,8 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
 
       // The judge: full vibration at the finest step, over the seeds.
       // The primitive bowl's judge steps with its scene file's solver.time_step.
-      const int ref_spc = byBowlPhase(entry) ? static_cast<int>(std::lround(
-                                                   1.0 / (f * scene.solver.time_step)))
+      const int ref_spc = byBowlPhase(entry)
+                              ? static_cast<int>(std::lround(1.0 / (f * scene.solver.time_step)))
                           : entry.judge_steps_per_cycle > 0 ? entry.judge_steps_per_cycle
                           : o.quick                         ? 400
                                                             : o.reference_steps_per_cycle;

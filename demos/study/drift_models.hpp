@@ -34,8 +34,8 @@ struct DriftModelStudyOptions {
 };
 
 /// Runs the comparison and writes drift_models.{csv,md,png} into out_dir (the primitive bowl
-/// also bowl_primitives_height.{csv,png}: mean height (m) against time (s) per method and model, and
-/// bowl_primitives_trace_<run>.csv: every nut's centre and phase at every sample). Returns the
+/// also bowl_primitives_height.{csv,png}: mean height (m) against time (s) per method and model,
+/// and bowl_primitives_trace_<run>.csv: every nut's centre and phase at every sample). Returns the
 /// process exit code (0, or 2 with a message on stderr for bad options or a failed run).
 int runDriftModelStudy(const DriftModelStudyOptions& options);
 

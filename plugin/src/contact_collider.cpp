@@ -233,8 +233,8 @@ void ContactCollider::addContacts(dGeomID o1, dGeomID o2, dContact* contacts, in
       if (feedback_used_ == feedback_.size()) feedback_.emplace_back();
       fb = &feedback_[feedback_used_++];
       *fb = dJointFeedback{};
-      if (warm && warm_force_[static_cast<std::size_t>(i)].has_force) {
-        const Vec3 f = warm_force_[static_cast<std::size_t>(i)].force;  // on g1's body
+      if (warm && warm_starts_[static_cast<std::size_t>(i)].has_force) {
+        const Vec3 f = warm_starts_[static_cast<std::size_t>(i)].force;  // on g1's body
         const Vec3 f1 = first_body_is_g1 ? f : -f;
         fb->f1[0] = f1.x;
         fb->f1[1] = f1.y;
@@ -244,7 +244,7 @@ void ContactCollider::addContacts(dGeomID o1, dGeomID o2, dContact* contacts, in
     }
     const dReal* n_i = contacts[i].geom.normal;
     const dReal* p_i = contacts[i].geom.pos;
-    const bool persisted = warm && warm_force_[static_cast<std::size_t>(i)].persisted;
+    const bool persisted = warm && warm_starts_[static_cast<std::size_t>(i)].persisted;
     joints_.push_back({contacts[i].geom.g1,
                        contacts[i].geom.g2,
                        {n_i[0], n_i[1], n_i[2]},
@@ -287,7 +287,7 @@ void ContactCollider::keepWarmStarts() {
 }
 
 void ContactCollider::applyWarmStarts(dGeomID o1, dGeomID o2, dContact* contacts, int n) {
-  warm_force_.assign(static_cast<std::size_t>(n), WarmStart{});
+  warm_starts_.assign(static_cast<std::size_t>(n), WarmStart{});
   const bool o1_lo = std::less<dGeomID>()(o1, o2);
   const dGeomID lo = o1_lo ? o1 : o2, hi = o1_lo ? o2 : o1;
   const auto first =
@@ -317,7 +317,7 @@ void ContactCollider::applyWarmStarts(dGeomID o1, dGeomID o2, dContact* contacts
     }
     if (!best) continue;
     best->used = true;
-    WarmStart& w = warm_force_[static_cast<std::size_t>(i)];
+    WarmStart& w = warm_starts_[static_cast<std::size_t>(i)];
     w.persisted = true;
     if (!best->persisted) continue;  // its force was a first impact's
     // the force on the body of this contact's g1 (the previous force was on lo's body)

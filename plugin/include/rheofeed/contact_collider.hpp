@@ -256,7 +256,7 @@ class ContactCollider {
     bool persisted = false, has_force = false;
     Vec3 force;
   };
-  std::vector<WarmStart> warm_force_;
+  std::vector<WarmStart> warm_starts_;
   int warm_started_count_ = 0;
 };
 
