@@ -158,13 +158,37 @@ std::optional<Record> readRecord(const Folder& folder, const Manifest& manifest,
 /// The ids of the jobs without a record of status "ok", in job order.
 std::vector<std::string> unfinishedJobs(const Folder& folder, const Manifest& manifest);
 
+/// The `sweep job` process running job `id`: it holds the job's lock, jobs/<id>/job.lock (an
+/// exclusive flock, released by the kernel when the process ends), which names its pid and host.
+struct RunningJob {
+  int pid = 0;  ///< 0: no process holds the lock (or it named no pid)
+  std::string host;
+};
+/// The process running job `id` now, if any (pid 0 otherwise).
+RunningJob runningJob(const Folder& folder, const std::string& id);
+/// Stops the `sweep job` processes of this host still running one of `ids` (SIGTERM; SIGKILL
+/// after 10 s) and waits until their locks are free, printing each on stdout after `who: `. For
+/// a backend that lost track of a job (GNU parallel stopped by a signal before it listed a job
+/// it had just started, which then ran on and wrote its record after the sweep had returned).
+/// Returns how many are still running (on another host, or not stopped in 15 s), each printed.
+int stopStrayJobs(const Folder& folder, const std::vector<std::string>& ids,
+                  const std::string& who);
+
+/// The environment variable a backend sets to its stop file before it starts the jobs. A `sweep
+/// job` started with it that finds the file once it holds its job's lock does not run: the
+/// backend was interrupted before it could signal that job (it writes the file, then stops the
+/// jobs holding a lock; a job takes its lock, then looks for the file; so no job runs on).
+constexpr const char* kStopFileVariable = "RHEOFEED_SWEEP_STOP_FILE";
+
 /// The command that runs (or reruns) job `id` by hand.
 std::string jobCommand(const Folder& folder, const std::string& id);
 
 /// Runs job `id` unless it has an "ok" record: `rheofeed run` of its scene file into
 /// jobs/<id>/run, then writes its record. Returns 0 for a finished job (now or before), 1 for a
-/// failed one (its record says why), 130/143 when interrupted by SIGINT/SIGTERM (no record; the
-/// run is stopped too). Prints one line on stdout per job.
+/// failed one (its record says why) or one another process is running (no record; the line
+/// names that process), 130/143 when interrupted by SIGINT/SIGTERM (no record; the run is
+/// stopped too) or started by a backend that has since been interrupted (kStopFileVariable). Holds
+/// the job's lock while it runs. Prints one line on stdout per job.
 int runJob(const Folder& folder, const Manifest& manifest, const std::string& id);
 
 /// Backends. Each runs `rheofeed sweep job DIR ID` for the unfinished jobs and returns the

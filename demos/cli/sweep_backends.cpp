@@ -5,10 +5,12 @@
 // once).
 #include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -136,6 +138,13 @@ int runParallel(const Folder& folder, const Manifest& manifest, int jobs,
   std::printf("parallel: %zu of %d jobs to run: %s\n", unfinishedJobs(folder, manifest).size(),
               total, shown.c_str());
   std::fflush(stdout);
+  // This run's stop file (kStopFileVariable); an earlier run's is stale.
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (entry.path().filename().string().rfind("stop.", 0) == 0) fs::remove(entry.path(), ec);
+  }
+  const fs::path stop_file = dir / ("stop." + std::to_string(::getpid()));
+  ::setenv(kStopFileVariable, absolutePath(stop_file).c_str(), 1);
   catchStopSignals();
   int pid = 0;
   try {
@@ -145,6 +154,12 @@ int runParallel(const Folder& folder, const Manifest& manifest, int jobs,
   }
   const int status = waitFor(pid);
   if (stopSignal() != 0) {
+    // GNU parallel signals the jobs it lists as running; one it had just started may not be
+    // listed yet, and would write its record after this command said it was interrupted. The
+    // stop file first, then the locks (kStopFileVariable says why that order leaves none).
+    scene::writeFileAtomically(stop_file,
+                               "interrupted by signal " + std::to_string(stopSignal()) + "\n");
+    stopStrayJobs(folder, unfinishedJobs(folder, manifest), "parallel");
     std::printf(
         "parallel: interrupted by signal %d; run the same command to resume (finished "
         "jobs are not run again)\n",

@@ -4,6 +4,7 @@
 #include <sched.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/file.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <fstream>
@@ -115,6 +117,56 @@ std::string lastMessage(const fs::path& log) {
   }
   return !last_run.empty() ? last_run : last;
 }
+
+std::string hostName() {
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  return host;
+}
+
+fs::path jobLockFile(const Folder& folder, const std::string& id) {
+  return folder.jobDir(id) / "job.lock";
+}
+
+// Job `id`'s lock, held (flock, exclusive) by the one `sweep job` process that runs it, for as
+// long as it runs; the file says "PID HOST". The kernel releases it when the process ends, however
+// it ends. Not inherited by the run it starts (O_CLOEXEC).
+class JobLock {
+ public:
+  JobLock(const Folder& folder, const std::string& id) {
+    const fs::path file = jobLockFile(folder, id);
+    std::error_code ec;
+    fs::create_directories(file.parent_path(), ec);
+    fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) {
+      throw std::runtime_error("job " + id + ": cannot open its lock " + file.string() + ": " +
+                               std::strerror(errno));
+    }
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      const RunningJob other = runningJob(folder, id);
+      ::close(fd_);
+      fd_ = -1;
+      holder_ = other.pid > 0 ? "process " + std::to_string(other.pid) + " on " + other.host
+                              : "another process";
+      return;
+    }
+    const std::string text = std::to_string(::getpid()) + " " + hostName() + "\n";
+    if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, text.data(), text.size(), 0) < 0) {
+      // The lock holds without the text; only stopStrayJobs reads it.
+    }
+  }
+  ~JobLock() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  JobLock(const JobLock&) = delete;
+  JobLock& operator=(const JobLock&) = delete;
+  bool held() const { return fd_ >= 0; }
+  const std::string& holder() const { return holder_; }
+
+ private:
+  int fd_ = -1;
+  std::string holder_;
+};
 
 }  // namespace
 
@@ -381,6 +433,69 @@ std::vector<std::string> unfinishedJobs(const Folder& folder, const Manifest& ma
   return ids;
 }
 
+RunningJob runningJob(const Folder& folder, const std::string& id) {
+  const int fd = ::open(jobLockFile(folder, id).c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return {};
+  RunningJob r;
+  if (::flock(fd, LOCK_SH | LOCK_NB) == 0) {
+    ::close(fd);  // nobody holds it
+    return r;
+  }
+  char text[320] = {};
+  const ssize_t n = ::pread(fd, text, sizeof text - 1, 0);
+  ::close(fd);
+  std::istringstream in(std::string(text, n > 0 ? static_cast<std::size_t>(n) : 0));
+  in >> r.pid >> r.host;
+  if (r.pid <= 0) r.pid = -1;  // held, by a process that has not written its pid yet
+  return r;
+}
+
+int stopStrayJobs(const Folder& folder, const std::vector<std::string>& ids,
+                  const std::string& who) {
+  const std::string here = hostName();
+  std::vector<std::string> stray;
+  for (const std::string& id : ids) {
+    const RunningJob r = runningJob(folder, id);
+    if (r.pid == 0) continue;
+    stray.push_back(id);
+    if (r.pid > 0 && r.host == here) {
+      std::printf("%s: job %s still running (process %d) after the backend stopped: stopping it\n",
+                  who.c_str(), id.c_str(), r.pid);
+      ::kill(r.pid, SIGTERM);
+      ::kill(r.pid, SIGCONT);  // a stopped process handles the TERM when it runs again
+    }
+  }
+  std::fflush(stdout);
+  const auto start = std::chrono::steady_clock::now();
+  bool killed = false;
+  while (!stray.empty()) {
+    std::vector<std::string> left;
+    for (const std::string& id : stray) {
+      if (runningJob(folder, id).pid != 0) left.push_back(id);
+    }
+    stray = left;
+    const double t =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (stray.empty() || t > 15.0) break;
+    if (t > 10.0 && !killed) {
+      for (const std::string& id : stray) {
+        const RunningJob r = runningJob(folder, id);
+        if (r.pid > 0 && r.host == here) ::kill(r.pid, SIGKILL);
+      }
+      killed = true;
+    }
+    ::usleep(20000);
+  }
+  for (const std::string& id : stray) {
+    const RunningJob r = runningJob(folder, id);
+    std::printf("%s: job %s is still running (process %d on %s); its record may appear later\n",
+                who.c_str(), id.c_str(), r.pid,
+                r.host.empty() ? "an unknown host" : r.host.c_str());
+  }
+  std::fflush(stdout);
+  return static_cast<int>(stray.size());
+}
+
 std::string jobCommand(const Folder& folder, const std::string& id) {
   return "rheofeed sweep job " +
          shellQuoted(fs::absolute(folder.root).lexically_normal().string()) + " " + id;
@@ -399,6 +514,23 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
     throw std::invalid_argument("job " + id + ": no such job in " + folder.manifest().string() +
                                 " (ids " + jobId(0, count) + " to " + jobId(count - 1, count) +
                                 ")");
+  }
+  // The lock first, then the record: a process that held the lock has written its record.
+  const JobLock lock(folder, id);
+  if (!lock.held()) {
+    std::printf("job %s: not started: %s is running it (lock %s)\n", id.c_str(),
+                lock.holder().c_str(), jobLockFile(folder, id).string().c_str());
+    std::fflush(stdout);
+    return 1;
+  }
+  if (const char* stop = std::getenv(kStopFileVariable); stop && *stop) {
+    std::error_code ec;
+    if (fs::exists(stop, ec)) {
+      std::printf("job %s: not started: the sweep that started it was interrupted (%s)\n",
+                  id.c_str(), stop);
+      std::fflush(stdout);
+      return 128 + SIGTERM;
+    }
   }
   std::optional<Record> done;
   try {
@@ -446,9 +578,7 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
                  {"command", command},
                  {"host", ""},
                  {"finished_utc", ""}};
-  char host[256] = {};
-  gethostname(host, sizeof host - 1);
-  record["host"] = host;
+  record["host"] = hostName();
 
   std::string scene_text;
   try {

@@ -8,6 +8,10 @@
 #      parallel) exits 130 leaving only whole records; run again, it runs only the jobs without
 #      a record (counted from its output) and leaves the earlier records untouched (same inode and
 #      modification time: never rewritten), and its CSV equals the whole sweep's.
+#   3. a job already running (its `sweep job` process stopped with SIGSTOP while it holds the
+#      job's lock) is not started a second time (exit 1, the line names the process); with
+#      GNU parallel, an interrupted sweep stops such a stray job before it returns, so no record
+#      appears after it said it was interrupted.
 #   bash sweep_backend_test.sh RHEOFEED SPEC WORK_DIR BACKEND [REFERENCE_CSV]
 set -euo pipefail
 bin=$1 spec=$2 work=$3 backend=$4 reference=${5:-}
@@ -76,3 +80,52 @@ done < "$work/before.txt"
 cmp "$work/full/results/sweep.csv" "$work/resumed/results/sweep.csv" ||
   fail "the resumed sweep's CSV differs from the whole sweep's"
 echo "resumed: ran the $ran unfinished jobs; the $done_before earlier records untouched; CSV identical"
+
+# 3. A job that is already running.
+"$bin" sweep job "$work/resumed" 0003 > /dev/null 2>&1 || fail "job 0003 of the finished sweep exited with $?"
+stray_dir=$work/stray
+"$bin" sweep "$spec" --backend "$backend" --jobs 1 --out "$stray_dir" > "$work/stray_first.log" 2>&1 &
+pid=$!
+for _ in $(seq 1 6000); do
+  [ -n "$(ls "$stray_dir/records" 2>/dev/null)" ] && break
+  kill -0 "$pid" 2>/dev/null || break
+  sleep 0.05
+done
+kill -"$signal" "$pid" 2>/dev/null || true
+wait "$pid" || true
+[ -f "$stray_dir/records/0003.json" ] && fail "job 0003 finished before the interruption (the test expects it unfinished)"
+"$bin" sweep job "$stray_dir" 0003 > "$work/stray_job.log" 2>&1 &
+stray=$!
+for _ in $(seq 1 6000); do
+  [ -s "$stray_dir/jobs/0003/job.lock" ] && break
+  kill -0 "$stray" 2>/dev/null || fail "job 0003 ended before it took its lock"
+  sleep 0.01
+done
+kill -STOP "$stray"
+set +e
+"$bin" sweep job "$stray_dir" 0003 > "$work/second_job.log" 2>&1
+code=$?
+set -e
+[ "$code" -eq 1 ] || fail "a second process for the running job 0003 exited with $code, expected 1"
+grep -q "job 0003: not started: process $stray on .* is running it" "$work/second_job.log" ||
+  fail "the second process did not name the running one ($stray)"
+if [ "$backend" = parallel ]; then
+  "$bin" sweep "$spec" --backend "$backend" --jobs 1 --out "$stray_dir" > "$work/stray_sweep.log" 2>&1 &
+  pid=$!
+  for _ in $(seq 1 6000); do
+    [ "$(ls "$stray_dir/records" | wc -l)" -ge 2 ] && break
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.05
+  done
+  kill -TERM "$pid" 2>/dev/null || true
+  wait "$pid" || true
+  grep -q "parallel: job 0003 still running (process $stray) after the backend stopped: stopping it" "$work/stray_sweep.log" ||
+    fail "the interrupted sweep did not stop the stray job 0003 (process $stray)"
+  kill -0 "$stray" 2>/dev/null && fail "the stray job 0003 (process $stray) still runs after the sweep returned"
+  echo "a stray job was stopped by the interrupted GNU parallel sweep before it returned"
+else
+  kill -CONT "$stray"
+  kill -TERM "$stray"
+fi
+wait "$stray" || true
+echo "a running job is not started a second time"
