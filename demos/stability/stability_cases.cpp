@@ -466,6 +466,14 @@ StabilityCase beltSpeed(double speed, double h, bool lone, double mu = 0.5) {
   }
   b.scene().material.mu = mu;
   b.scene().solver.time_step = h;
+  if (!lone && speed >= 3) {
+    // Measured over seeds 1-8 at 3 m/s: 6 of 80 boxes lost at h = 0.01 s, 3 at 0.002 s and 4 at
+    // 0.001 s (and 1 of 60 over seeds 1-6 at 10 m/s, h = 0.01 s): the step does not make it.
+    b.kase().note =
+        "boxes dropped onto a belt at >= 3 m/s tumble as it catches them; a few leave over its "
+        "open sides (lost, must be reported)";
+    b.kase().expect_losses = true;
+  }
   return b.finish();
 }
 

@@ -225,6 +225,35 @@ TEST(ContactCollider, SpeculativeContactsLandAFastCubeOnAThinPlate) {
   EXPECT_LT(norm(linearVelocity(drop.cube)), 1e-3);
 }
 
+// A 10 mm cube dropped flat from 8 mm above a static cube of its own size, exactly aligned, at
+// h = 14.3 ms (a tenth of its edge is g h^2 / 2: the step of the mass-ratio probe at X = 5,
+// check_mass_ratio.cpp): it moves 4.4 mm in its landing step, so it lands on speculative
+// contacts, whose rays from its four lower corners meet the other cube's top face at its four
+// corners. Landing square on a face it must not turn (the symmetry; the solver's row order
+// leaves some 0.1 rad/s) and must come to rest on it. Rays cast from the exact corners grazed
+// the edges and hit or missed by rounding: the cube landed spinning at 24 rad/s and toppled.
+TEST(ContactCollider, SpeculativeContactsLandACubeFlatOnAnEqualCubeWithoutTurningIt) {
+  constexpr double edge = 0.01, h = 0.0143, gap = 0.8 * edge;
+  ContactCollider::Settings s;
+  s.speculative = true;
+  OdeWorld w({}, s);
+  w.setSurface(dContactApprox1, kMu);
+  w.staticBox(edge, edge, edge, 0, 0, -0.5 * edge);  // its top face at z = 0
+  dBodyID cube = w.box(edge, edge, edge, 0.003, 0, 0, gap + 0.5 * edge);
+  double max_turn = 0;
+  long speculative_contacts = 0;
+  for (double t = 0; t < 0.5; t += h) {
+    w.collider->collide(w.space, t, h);
+    speculative_contacts += w.collider->speculativeContactCount();
+    dWorldQuickStep(w.world, h);
+    max_turn = std::max(max_turn, norm(angularVelocity(cube)));
+  }
+  EXPECT_GT(speculative_contacts, 0);
+  EXPECT_LT(max_turn, 1.0);  // rad/s
+  EXPECT_NEAR(position(cube).z, 0.5 * edge, 2e-4);
+  EXPECT_LT(norm(linearVelocity(cube)), 1e-3);
+}
+
 // A sphere thrown sideways at a 2 mm wall at 4 m/s (40 mm per step) stops against it.
 TEST(ContactCollider, SpeculativeContactsStopASphereAtAThinWall) {
   ContactCollider::Settings s;

@@ -24,8 +24,10 @@
 /// thickness in a step (a box falling from a hopper at h = 0.01 s) can land with its centre
 /// inside a fixture, or pass through a thin one. With Settings::speculative, collide() sweeps
 /// each fast body (Settings::speculative_fraction) along its velocity at the end of the step:
-/// rays from its leading points (a box's 8 corners; a sphere's or capsule's point ahead; four rim
-/// points of each end of a cylinder; for other shapes (meshes, convex hulls) the corners of the
+/// rays from its leading points (a box's 8 corners and four rim points of each end of a cylinder,
+/// each 1e-4 of the half extent inside the surface so that a ray from a corner of a box landing
+/// flat on an equal box cannot graze that box's edge; a sphere's or capsule's point ahead; for
+/// other shapes (meshes, convex hulls) the corners of the
 /// geom's bounding box, which may stop a part up to that box's
 /// slack short of the surface for one step) over the travel |v + g h| h, against every geom of
 /// the space that the regular pass did not already pair with it. A ray that hits at distance t
