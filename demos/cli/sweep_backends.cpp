@@ -135,9 +135,6 @@ int runParallel(const Folder& folder, const Manifest& manifest, int jobs,
   argv.insert(argv.end(), {"::::", absolutePath(job_file)});
   std::string shown;
   for (const std::string& a : argv) shown += (shown.empty() ? "" : " ") + shellQuoted(a);
-  std::printf("parallel: %zu of %d jobs to run: %s\n", unfinishedJobs(folder, manifest).size(),
-              total, shown.c_str());
-  std::fflush(stdout);
   // This run's stop file (kStopFileVariable); an earlier run's is stale.
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
@@ -145,7 +142,10 @@ int runParallel(const Folder& folder, const Manifest& manifest, int jobs,
   }
   const fs::path stop_file = dir / ("stop." + std::to_string(::getpid()));
   ::setenv(kStopFileVariable, absolutePath(stop_file).c_str(), 1);
-  catchStopSignals();
+  catchStopSignals();  // before the line: once it is printed, a stop signal is handled
+  std::printf("parallel: %zu of %d jobs to run: %s\n", unfinishedJobs(folder, manifest).size(),
+              total, shown.c_str());
+  std::fflush(stdout);
   int pid = 0;
   try {
     pid = spawnProcess(argv);

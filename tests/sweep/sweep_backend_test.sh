@@ -8,10 +8,10 @@
 #      parallel) exits 130 leaving only whole records; run again, it runs only the jobs without
 #      a record (counted from its output) and leaves the earlier records untouched (same inode and
 #      modification time: never rewritten), and its CSV equals the whole sweep's.
-#   3. a job already running (its `sweep job` process stopped with SIGSTOP while it holds the
-#      job's lock) is not started a second time (exit 1, the line names the process); with
-#      GNU parallel, an interrupted sweep stops such a stray job before it returns, so no record
-#      appears after it said it was interrupted.
+#   3. a job already running (a shell holding the job's lock as `sweep job` does) is not started
+#      a second time (exit 1, the line names the process); with GNU parallel, an interrupted
+#      sweep stops such a stray job before it returns, so no record appears after it said it was
+#      interrupted.
 #   bash sweep_backend_test.sh RHEOFEED SPEC WORK_DIR BACKEND [REFERENCE_CSV]
 set -euo pipefail
 bin=$1 spec=$2 work=$3 backend=$4 reference=${5:-}
@@ -81,51 +81,52 @@ cmp "$work/full/results/sweep.csv" "$work/resumed/results/sweep.csv" ||
   fail "the resumed sweep's CSV differs from the whole sweep's"
 echo "resumed: ran the $ran unfinished jobs; the $done_before earlier records untouched; CSV identical"
 
-# 3. A job that is already running.
-"$bin" sweep job "$work/resumed" 0003 > /dev/null 2>&1 || fail "job 0003 of the finished sweep exited with $?"
+# 3. A job that is already running: a shell holds job 0003's lock the way `sweep job` does
+#    (flock on jobs/0003/job.lock, its pid and host written in it) for as long as the test wants.
 stray_dir=$work/stray
-"$bin" sweep "$spec" --backend "$backend" --jobs 1 --out "$stray_dir" > "$work/stray_first.log" 2>&1 &
-pid=$!
-for _ in $(seq 1 6000); do
-  [ -n "$(ls "$stray_dir/records" 2>/dev/null)" ] && break
-  kill -0 "$pid" 2>/dev/null || break
-  sleep 0.05
-done
-kill -"$signal" "$pid" 2>/dev/null || true
-wait "$pid" || true
-[ -f "$stray_dir/records/0003.json" ] && fail "job 0003 finished before the interruption (the test expects it unfinished)"
-"$bin" sweep job "$stray_dir" 0003 > "$work/stray_job.log" 2>&1 &
-stray=$!
-for _ in $(seq 1 6000); do
-  [ -s "$stray_dir/jobs/0003/job.lock" ] && break
-  kill -0 "$stray" 2>/dev/null || fail "job 0003 ended before it took its lock"
+# The folder without running any job: the Slurm backend only writes its scripts.
+"$bin" sweep "$spec" --backend slurm --out "$stray_dir" > "$work/stray_prepare.log" 2>&1 ||
+  fail "preparing $stray_dir (Slurm scripts, no job run) exited with $?"
+lock=$stray_dir/jobs/0003/job.lock
+(
+  exec 9<> "$lock"
+  flock -x 9
+  echo "$BASHPID $(hostname)" > "$lock"
+  exec sleep 1000
+) &
+holder=$!
+until [ -s "$lock" ]; do
+  kill -0 "$holder" 2> /dev/null || fail "the shell holding job 0003's lock ended"
   sleep 0.01
 done
-kill -STOP "$stray"
 set +e
 "$bin" sweep job "$stray_dir" 0003 > "$work/second_job.log" 2>&1
 code=$?
 set -e
 [ "$code" -eq 1 ] || fail "a second process for the running job 0003 exited with $code, expected 1"
-grep -q "job 0003: not started: process $stray on .* is running it" "$work/second_job.log" ||
-  fail "the second process did not name the running one ($stray)"
+grep -q "job 0003: not started: process $holder on .* is running it" "$work/second_job.log" ||
+  fail "the second process did not name the running one ($holder)"
 if [ "$backend" = parallel ]; then
+  # Interrupted once its signal handlers are in place (the line it prints before it starts GNU
+  # parallel), whatever GNU parallel has done by then, the sweep stops the job it cannot signal.
   "$bin" sweep "$spec" --backend "$backend" --jobs 1 --out "$stray_dir" > "$work/stray_sweep.log" 2>&1 &
   pid=$!
-  for _ in $(seq 1 6000); do
-    [ "$(ls "$stray_dir/records" | wc -l)" -ge 2 ] && break
-    kill -0 "$pid" 2>/dev/null || break
-    sleep 0.05
+  until grep -q '^parallel: [0-9]* of [0-9]* jobs to run' "$work/stray_sweep.log"; do
+    kill -0 "$pid" 2> /dev/null || fail "the sweep ended before it started GNU parallel"
+    sleep 0.01
   done
-  kill -TERM "$pid" 2>/dev/null || true
-  wait "$pid" || true
-  grep -q "parallel: job 0003 still running (process $stray) after the backend stopped: stopping it" "$work/stray_sweep.log" ||
-    fail "the interrupted sweep did not stop the stray job 0003 (process $stray)"
-  kill -0 "$stray" 2>/dev/null && fail "the stray job 0003 (process $stray) still runs after the sweep returned"
+  kill -TERM "$pid"
+  set +e
+  wait "$pid"
+  code=$?
+  set -e
+  [ "$code" -eq 130 ] || fail "the interrupted sweep exited with $code, expected 130"
+  grep -q "parallel: job 0003 still running (process $holder) after the backend stopped: stopping it" "$work/stray_sweep.log" ||
+    fail "the interrupted sweep did not stop the stray job 0003 (process $holder)"
+  kill -0 "$holder" 2> /dev/null && fail "the stray job 0003 (process $holder) still runs after the sweep returned"
   echo "a stray job was stopped by the interrupted GNU parallel sweep before it returned"
 else
-  kill -CONT "$stray"
-  kill -TERM "$stray"
+  kill -TERM "$holder"
 fi
-wait "$stray" || true
+wait "$holder" || true
 echo "a running job is not started a second time"
