@@ -143,6 +143,13 @@ class JobLock {
                                std::strerror(errno));
     }
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      if (errno != EWOULDBLOCK) {  // not held by another process: the lock cannot be taken here
+        const std::string why = std::strerror(errno);
+        ::close(fd_);
+        fd_ = -1;
+        throw std::runtime_error("job " + id + ": cannot lock " + file.string() + " (flock: " +
+                                 why + "); the sweep folder needs a file system with flock");
+      }
       const RunningJob other = runningJob(folder, id);
       ::close(fd_);
       fd_ = -1;
@@ -152,7 +159,11 @@ class JobLock {
     }
     const std::string text = std::to_string(::getpid()) + " " + hostName() + "\n";
     if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, text.data(), text.size(), 0) < 0) {
-      // The lock holds without the text; only stopStrayJobs reads it.
+      // The lock holds without the text, but an interrupted backend cannot name or stop us.
+      std::fprintf(stderr,
+                   "rheofeed sweep job: job %s: cannot write its pid into %s (%s); an "
+                   "interrupted sweep will not be able to stop this process\n",
+                   id.c_str(), file.c_str(), std::strerror(errno));
     }
   }
   ~JobLock() {

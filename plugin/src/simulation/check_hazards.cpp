@@ -169,9 +169,12 @@ void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out) {
   if ((quickstep || !c.ode) && c.total_parts >= 2 && c.lightest < kInf && c.heaviest > 0) {
     const double ratio = c.heaviest / c.lightest;
     const int k = c.scene.solver.iterations;
-    const double limit = quickstep
-                             ? odeQuickstepMassRatioLimit(k, c.light_thickness, c.h, c.g, warm)
-                             : referenceMassRatioLimit(k, c.light_thickness, c.h, c.g);
+    // The measured limit of this scene's engine at `iterations` and step h.
+    auto limitAt = [&](int iterations, double h) {
+      return quickstep ? odeQuickstepMassRatioLimit(iterations, c.light_thickness, h, c.g, warm)
+                       : referenceMassRatioLimit(iterations, c.light_thickness, h, c.g);
+    };
+    const double limit = limitAt(k, c.h);
     if (ratio > limit) {
       Hazard hz;
       hz.kind = Hazard::Kind::MassRatio;
@@ -197,19 +200,12 @@ void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out) {
       int need = 0;
       for (int kk :
            quickstep ? std::vector<int>{10, 20, 50, 100, 200} : std::vector<int>{20, 50, 100}) {
-        const double l = quickstep
-                             ? odeQuickstepMassRatioLimit(kk, c.light_thickness, c.h, c.g, warm)
-                             : referenceMassRatioLimit(kk, c.light_thickness, c.h, c.g);
-        if (!need && ratio <= l) need = kk;
+        if (!need && ratio <= limitAt(kk, c.h)) need = kk;
       }
       if (need) s << "solver.iterations >= " << need << ", or ";
       // The largest step (in factors of 0.8, down to 1e-3 of the step) whose limit holds the
       // ratio; none when the measured tables never do at these iterations.
-      auto holds = [&](double step) {
-        return ratio <= (quickstep
-                             ? odeQuickstepMassRatioLimit(k, c.light_thickness, step, c.g, warm)
-                             : referenceMassRatioLimit(k, c.light_thickness, step, c.g));
-      };
+      auto holds = [&](double step) { return ratio <= limitAt(k, step); };
       double safe_h = c.h;
       while (!holds(safe_h) && safe_h > 1e-3 * c.h) safe_h *= 0.8;
       if (holds(safe_h)) s << c.step_field << " <= " << fmt(safe_h) << " s, or ";
