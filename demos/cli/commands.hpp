@@ -25,6 +25,10 @@ struct RunArgs {
   bool out_given = false;
   bool animation = true;
   CalibrateOptions calibrate;
+  /// --drift-table FILE: the local law's drift table (rheofeed/scene/drift_table_file.hpp), read
+  /// before the runs when the file exists and written back, with the corners the runs added,
+  /// after them; empty: none.
+  std::string drift_table;
 };
 int runCommand(const RunArgs& args);
 

@@ -16,7 +16,9 @@
 #include "rheofeed/output/animation.hpp"
 #include "rheofeed/output/output.hpp"
 #include "rheofeed/output/plot.hpp"
+#include "rheofeed/scene/drift_table_file.hpp"
 #include "rheofeed/simulation/check.hpp"
+#include "rheofeed/vibration_drift.hpp"
 
 namespace rheofeed::cli {
 
@@ -75,6 +77,46 @@ void plotRuns(const std::vector<std::pair<std::string, std::string>>& blocks,
 
 }  // namespace
 
+namespace {
+
+// --drift-table: the shared table's corners from FILE, when it exists (a bad file is bad input).
+void openDriftTable(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) {
+    const std::filesystem::path folder =
+        file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+    if (!std::filesystem::is_directory(folder, ec)) {
+      throw std::invalid_argument("--drift-table " + file.string() + ": the folder " +
+                                  folder.string() + " does not exist");
+    }
+    std::fprintf(stderr,
+                 "rheofeed run: drift table %s does not exist yet: it is written after the runs\n",
+                 file.string().c_str());
+    return;
+  }
+  LocalDriftTable& table = *LocalDriftTable::shared();
+  const std::size_t added = loadDriftTable(file, table);
+  std::fprintf(stderr, "rheofeed run: drift table %s: %zu point-mass corners read\n",
+               file.string().c_str(), added);
+}
+
+// After the runs: the shared table written back to FILE (atomically), or why not.
+void saveDriftTable(const std::filesystem::path& file, bool used) {
+  if (!used) {
+    std::fprintf(stderr,
+                 "rheofeed run: --drift-table %s ignored: no run used the local vibration law "
+                 "(the file is left as it was)\n",
+                 file.string().c_str());
+    return;
+  }
+  const LocalDriftTable& table = *LocalDriftTable::shared();
+  writeFileAtomically(file, driftTableJson(table));
+  std::fprintf(stderr, "rheofeed run: drift table %s written: %zu point-mass corners\n",
+               file.string().c_str(), table.numCorners());
+}
+
+}  // namespace
+
 int runCommand(const RunArgs& args) {
   Plan plan;
   std::filesystem::path out;
@@ -83,6 +125,7 @@ int runCommand(const RunArgs& args) {
     out = !args.out_given ? std::filesystem::path("out") / plan.name
                           : std::filesystem::path(args.out);
     prepareOutputFolder(out, "--out");
+    if (!args.drift_table.empty()) openDriftTable(args.drift_table);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rheofeed run: %s\n", e.what());
     return 2;
@@ -127,6 +170,7 @@ int runCommand(const RunArgs& args) {
         unit.c_str());
     std::fflush(stdout);
     std::vector<std::pair<std::string, std::string>> blocks;
+    bool any_local_law = false;
     for (std::size_t k = 0; k < plan.runs.size(); ++k) {
       const PlannedRun& run = plan.runs[k];
       const Method m = run.method;
@@ -148,12 +192,14 @@ int runCommand(const RunArgs& args) {
       if (recorder) recorder->write(out / (toString(m) + std::string(".glb")));
       blocks.emplace_back(toString(m), seriesCsv(r));
       const RunHealth& h = r.health;
+      any_local_law = any_local_law || h.local_law_feeders > 0;
       std::printf("| %s | %.3g | %d | %.5f | %.5f | %.4f | %.2f | %.2f | %.4f | %d | %.1f %% |\n",
                   toString(m), r.time_step, r.parts, r.mean_drift, r.mean_drift_ci95,
                   r.vertical_displacement, r.throughput, r.cpu_seconds, r.real_time_factor,
                   h.partsLost(), 100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps));
       std::fflush(stdout);
     }
+    if (!args.drift_table.empty()) saveDriftTable(args.drift_table, any_local_law);
     if (blocks.size() > 1) {
       plotRuns(blocks, plan.scene.name + ": methods compared", "mean drift (" + unit + ")", "1:3",
                (out / "methods.png").string());

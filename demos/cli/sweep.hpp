@@ -110,6 +110,8 @@ struct Folder {
     return root / "records" / (id + ".json");
   }
   std::filesystem::path results() const { return root / "results"; }
+  /// The local law's drift table the jobs share (`rheofeed run --drift-table`).
+  std::filesystem::path driftTable() const { return root / "drift_table.json"; }
 };
 
 /// Creates DIR and writes the manifest and the jobs' scene files. A folder that already holds a

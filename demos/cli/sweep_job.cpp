@@ -564,9 +564,13 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
 
   std::string methods;
   for (const std::string& m : manifest.methods) methods += (methods.empty() ? "" : ",") + m;
-  const std::vector<std::string> argv = {
-      selfExe().string(), "run",  scene_file.string(), "--out", run_dir.string(), "--no-animation",
-      "--method",         methods};
+  // The jobs share one drift table (the local law's point-mass results, the same for every
+  // scene): each reads what the jobs before it wrote and writes back what it added.
+  const std::vector<std::string> argv = {selfExe().string(),  "run",
+                                         scene_file.string(), "--out",
+                                         run_dir.string(),    "--no-animation",
+                                         "--method",          methods,
+                                         "--drift-table",     folder.driftTable().string()};
   std::string command = "rheofeed";
   for (std::size_t k = 1; k < argv.size(); ++k) command += " " + shellQuoted(argv[k]);
 

@@ -224,10 +224,16 @@ MotionLaw MotionLaw::twistFunction(std::function<Twist(double)> twist_of_time, F
 
 MotionLaw MotionLaw::localVibration(const LocalVibration& vibration,
                                     const PointMassSettings& settings) {
+  return localVibration(vibration, std::make_shared<LocalDriftTable>(settings));
+}
+
+MotionLaw MotionLaw::localVibration(const LocalVibration& vibration,
+                                    std::shared_ptr<LocalDriftTable> table) {
+  if (!table) throw std::invalid_argument("MotionLaw::localVibration: the drift table is null");
   MotionLaw law;
   law.kind_ = Kind::LocalVibration;
   law.local_ = std::make_shared<const LocalVibration>(vibration);
-  law.table_ = std::make_shared<LocalDriftTable>(settings);
+  law.table_ = std::move(table);
   return law;
 }
 

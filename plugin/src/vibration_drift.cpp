@@ -16,9 +16,9 @@ namespace rheofeed {
 namespace {
 
 // Grid steps of LocalDriftTable (header).
-constexpr double kThrowStep = 0.025;
-constexpr double kTangentialThrowStep = 0.05;
-constexpr double kSlopeStep = 0.02;
+constexpr double kThrowStep = LocalDriftTable::kNormalThrowStep;
+constexpr double kTangentialThrowStep = LocalDriftTable::kTangentialThrowStep;
+constexpr double kSlopeStep = LocalDriftTable::kSlopeStep;
 
 // The relative state of the mass at the start of a cycle (units: velocities |g_n| / w, gap
 // |g_n| / w^2).
@@ -299,6 +299,87 @@ LocalDriftTable::LocalDriftTable(PointMassSettings settings) : impl_(std::make_u
   impl_->settings = settings;
 }
 LocalDriftTable::~LocalDriftTable() = default;
+
+std::shared_ptr<LocalDriftTable> LocalDriftTable::shared(const PointMassSettings& settings) {
+  static std::mutex mutex;
+  static std::vector<std::shared_ptr<LocalDriftTable>> tables;
+  std::lock_guard<std::mutex> lock(mutex);
+  for (const auto& table : tables) {
+    const PointMassSettings& t = table->settings();
+    if (t.steps_per_cycle == settings.steps_per_cycle && t.max_cycles == settings.max_cycles &&
+        t.average_cycles == settings.average_cycles && t.max_period == settings.max_period &&
+        bitsOf(t.periodic_tolerance) == bitsOf(settings.periodic_tolerance)) {
+      return table;
+    }
+  }
+  tables.push_back(std::make_shared<LocalDriftTable>(settings));
+  return tables.back();
+}
+
+const PointMassSettings& LocalDriftTable::settings() const {
+  return impl_->settings;
+}
+
+std::size_t LocalDriftTable::numCorners() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->corners.size();
+}
+
+std::vector<DriftTableCorner> LocalDriftTable::corners() const {
+  std::vector<DriftTableCorner> out;
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    out.reserve(impl_->corners.size());
+    for (const auto& [key, corner] : impl_->corners) {
+      DriftTableCorner c;
+      std::copy(std::begin(key.i), std::end(key.i), std::begin(c.grid));
+      std::memcpy(&c.mu, &key.mu, sizeof c.mu);
+      c.along = corner.v1;
+      c.across = corner.v2;
+      c.valid = corner.valid;
+      out.push_back(c);
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const DriftTableCorner& a, const DriftTableCorner& b) {
+    if (a.mu != b.mu) return a.mu < b.mu;
+    return std::lexicographical_compare(std::begin(a.grid), std::end(a.grid), std::begin(b.grid),
+                                        std::end(b.grid));
+  });
+  return out;
+}
+
+std::size_t LocalDriftTable::addCorners(const std::vector<DriftTableCorner>& corners) {
+  constexpr std::int64_t kMaxIndex = 1000000000;
+  for (std::size_t k = 0; k < corners.size(); ++k) {
+    const DriftTableCorner& c = corners[k];
+    std::ostringstream out;
+    out << "drift table corner " << k << ": ";
+    if (!std::isfinite(c.along) || !std::isfinite(c.across)) {
+      out << "drift (" << c.along << ", " << c.across << ") is not finite";
+      throw std::invalid_argument(out.str());
+    }
+    if (!(std::isfinite(c.mu) && c.mu >= 0)) {
+      out << "mu = " << c.mu << ": must be finite and >= 0";
+      throw std::invalid_argument(out.str());
+    }
+    for (int d = 0; d < 4; ++d) {
+      if (c.grid[d] < -kMaxIndex || c.grid[d] > kMaxIndex) {
+        out << "grid index " << d << " = " << c.grid[d] << ": must be in [-1e9, 1e9]";
+        throw std::invalid_argument(out.str());
+      }
+    }
+  }
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  std::size_t added = 0;
+  for (const DriftTableCorner& c : corners) {
+    CornerKey key;
+    std::copy(std::begin(c.grid), std::end(c.grid), std::begin(key.i));
+    key.mu = bitsOf(c.mu);
+    if (impl_->corners.emplace(key, Corner{c.along, c.across, c.valid}).second) ++added;
+  }
+  impl_->stats.corners_added += static_cast<std::int64_t>(added);
+  return added;
+}
 
 LocalDriftStats LocalDriftTable::stats() const {
   std::lock_guard<std::mutex> lock(impl_->mutex);

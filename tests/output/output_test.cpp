@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace rheofeed::scene {
@@ -133,6 +136,26 @@ TEST(WriteFileAtomically, AFailedRenameThrowsNamingThePathAndLeavesNoPartialFile
   }
   EXPECT_EQ(fileNames(folder), std::vector<std::string>{"taken"});  // no "taken.partial"
   EXPECT_TRUE(fs::is_directory(path / "inside"));
+}
+
+// Writers of one path at the same time (sweep jobs sharing a drift table): the file always holds
+// one writer's whole text, and no temporary file is left.
+TEST(WriteFileAtomically, ConcurrentWritersLeaveOneWholeText) {
+  const fs::path folder = freshFolder("concurrent");
+  const fs::path path = folder / "table.json";
+  std::vector<std::string> texts;
+  for (char c : {'a', 'b', 'c', 'd'}) texts.push_back(std::string(200000, c) + "\n");
+  std::vector<std::thread> writers;
+  for (const std::string& text : texts) {
+    writers.emplace_back([&path, &text] {
+      for (int k = 0; k < 20; ++k) writeFileAtomically(path, text);
+    });
+  }
+  for (std::thread& t : writers) t.join();
+  const std::string final_text = readFile(path);
+  EXPECT_NE(std::find(texts.begin(), texts.end(), final_text), texts.end())
+      << "a mix of " << final_text.size() << " bytes";
+  EXPECT_EQ(fileNames(folder), std::vector<std::string>{"table.json"});
 }
 
 TEST(WriteFileAtomically, AFolderThatCannotBeCreatedThrowsNamingIt) {

@@ -77,6 +77,8 @@ RunMetrics run() {
   h.local_law.wall_contacts = 5;
   h.local_law.cells_computed = 6;
   h.local_law.model_runs = 7;
+  h.local_law.corners_added = 9;
+  h.local_law_corners_at_start = 8;
   r.scene_check = {"tunnelling: step \\ 2\nsafe"};
   r.feeder.note = "the scene has no exit plane";
   return r;
@@ -163,6 +165,8 @@ TEST(SummaryJson, ParsesToTheRunMetricsWritten) {
   EXPECT_EQ(l["wall_contacts"], 5);
   EXPECT_EQ(l["cells_computed"], 6);
   EXPECT_EQ(l["model_runs"], 7);
+  EXPECT_EQ(l["corners_at_start"], 8);
+  EXPECT_EQ(l["corners_added"], 9);
 }
 
 TEST(SummaryJson, AngularRunsSayRadiansPerSecond) {

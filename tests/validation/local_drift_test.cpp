@@ -307,6 +307,71 @@ TEST(LocalDriftTable, RunsOnlyTheCornersAQueryWeights) {
   EXPECT_EQ(table.stats().cells_computed, 1);
 }
 
+// A table's corners carried into another table (a saved table read by the next run) give the
+// same drifts, bit for bit, with no model run; corners it already has are kept; a bad corner is
+// refused by its index and nothing of the batch is added.
+TEST(LocalDriftTable, CornersCarriedIntoAnotherTableGiveTheSameDriftsWithoutModelRuns) {
+  PointMassSettings settings;
+  settings.steps_per_cycle = 1024;
+  LocalDriftTable first(settings);
+  Lcg rng(11);
+  std::vector<PointMassParams> points;
+  for (int i = 0; i < 12; ++i) {
+    PointMassParams p;
+    p.normal_throw = rng.uniform(0.3, 2.0);
+    p.tangential_throw = rng.uniform(0.5, 3.0);
+    p.slope_along = rng.uniform(-0.1, 0.1);
+    p.slope_across = rng.uniform(0.0, 0.1);
+    p.mu = i % 2 ? 0.4 : 0.6;
+    points.push_back(p);
+    ASSERT_TRUE(first.drift(p).valid) << "point " << i;
+  }
+  const std::vector<DriftTableCorner> corners = first.corners();
+  ASSERT_EQ(corners.size(), first.numCorners());
+  ASSERT_EQ(static_cast<std::int64_t>(corners.size()), first.stats().model_runs);
+
+  LocalDriftTable second(settings);
+  EXPECT_EQ(second.addCorners(corners), corners.size());
+  EXPECT_EQ(second.stats().corners_added, static_cast<std::int64_t>(corners.size()));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const PointMassDrift a = first.drift(points[i]);
+    const PointMassDrift b = second.drift(points[i]);
+    EXPECT_EQ(a.along, b.along) << "point " << i;
+    EXPECT_EQ(a.across, b.across) << "point " << i;
+  }
+  EXPECT_EQ(second.stats().model_runs, 0);
+  EXPECT_EQ(second.addCorners(corners), 0u);  // all known
+
+  std::vector<DriftTableCorner> bad = {corners[0], corners[1]};
+  bad[0].grid[0] += 1000;  // a corner the table lacks, then a bad one
+  bad[1].along = std::numeric_limits<double>::quiet_NaN();
+  LocalDriftTable third(settings);
+  try {
+    third.addCorners(bad);
+    ADD_FAILURE() << "a NaN drift was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("corner 1: drift (nan"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(third.numCorners(), 0u);
+  bad[1] = corners[1];
+  bad[1].mu = -0.5;
+  EXPECT_THROW(third.addCorners(bad), std::invalid_argument);
+}
+
+// The scene layer's laws share one table per settings in a process; other settings get their
+// own.
+TEST(LocalDriftTable, OneSharedTablePerSettings) {
+  PointMassSettings coarse;
+  coarse.steps_per_cycle = 512;
+  const auto a = LocalDriftTable::shared(coarse);
+  EXPECT_EQ(LocalDriftTable::shared(coarse), a);
+  PointMassSettings other = coarse;
+  other.max_cycles = 300;
+  EXPECT_NE(LocalDriftTable::shared(other), a);
+  EXPECT_EQ(LocalDriftTable::shared(other)->settings().max_cycles, 300);
+  EXPECT_THROW(MotionLaw::localVibration(LocalVibration{}, nullptr), std::invalid_argument);
+}
+
 // The local drift at a contact in world geometry: a plane inclined along an arbitrary heading
 // is a classical straight track when the vibration lies in its vertical plane. A vibration
 // given with the opposite sign (half a period of phase) gives the same drift.

@@ -181,6 +181,11 @@ class MotionLaw {
   /// StepLaw::tangentialVelocity takes n as that outward normal and uses vibration.mu.
   static MotionLaw localVibration(const LocalVibration& vibration,
                                   const PointMassSettings& settings = {});
+  /// The same law on a given drift table (e.g. LocalDriftTable::shared(), or one filled from a
+  /// saved table), shared with its other users. Throws std::invalid_argument when `table` is
+  /// null.
+  static MotionLaw localVibration(const LocalVibration& vibration,
+                                  std::shared_ptr<LocalDriftTable> table);
 
   /// A copy of this law whose velocities are multiplied by `profile(t)`.
   MotionLaw withProfile(TimeProfile profile) const;
@@ -195,8 +200,11 @@ class MotionLaw {
   const TimeProfile& profile() const { return profile_; }
   /// The vibration of a LocalVibration law (nullptr for other kinds).
   const LocalVibration* localVibration() const { return local_.get(); }
-  /// Contact counts and table size of a LocalVibration law (zeros for other kinds).
+  /// Contact counts and table size of a LocalVibration law (zeros for other kinds); the table's
+  /// counts, summed over every law that shares it.
   LocalDriftStats localStats() const;
+  /// The drift table of a LocalVibration law (nullptr for other kinds).
+  const std::shared_ptr<LocalDriftTable>& localTable() const { return table_; }
   /// True if the law's values can change with time (a profile, a twist function, a time-varying
   /// field). Constant laws are evaluated once and cached.
   bool isTimeVarying() const;

@@ -50,12 +50,17 @@
 /// (Gamma, tau, s1, s2) lazily, the corners of a cell (up to 16) as contacts need them, and
 /// interpolates multilinearly in the cell (a corner of weight 0 - an input on a grid line, as
 /// s1 = s2 = 0 on a level floor - is not run); a contact whose inputs equal the previous contact's
-/// (every contact of a translating flat feeder) reuses the previous result. Units SI throughout.
+/// (every contact of a translating flat feeder) reuses the previous result. The corners do not
+/// depend on the feeder: the scene layer shares one table per process (LocalDriftTable::shared)
+/// and can save it between runs (rheofeed/scene/drift_table_file.hpp; `rheofeed run
+/// --drift-table`). Units SI throughout.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "rheofeed/vec3.hpp"
 
@@ -146,16 +151,62 @@ struct LocalDriftStats {
                                     ///< overhangs, steeper than the friction angle)
   std::int64_t cells_computed = 0;  ///< table cells filled
   std::int64_t model_runs = 0;      ///< pointMassDrift calls (grid corners)
+  std::int64_t corners_added = 0;   ///< grid corners taken from elsewhere (addCorners: a saved
+                                    ///< table), not run here
+};
+
+/// One grid corner of a LocalDriftTable: the point-mass drift (V1, V2) = (along, across), units
+/// |g_n| / w, at Gamma = grid[0] kNormalThrowStep, tau = grid[1] kTangentialThrowStep, s1 =
+/// grid[2] kSlopeStep, s2 = grid[3] kSlopeStep and friction mu (dimensionless); valid = false
+/// where the model refuses the corner (a slope at or beyond the friction angle).
+struct DriftTableCorner {
+  std::int64_t grid[4] = {0, 0, 0, 0};
+  double mu = 0;
+  double along = 0;
+  double across = 0;
+  bool valid = false;
 };
 
 /// The lazily filled drift table of one vibration (thread-safe; copies of a MotionLaw share
 /// it). Grid steps: Gamma 0.025, tau 0.05, s1 and s2 0.02 (a 1.15 degree slope).
+///
+/// A corner's value depends only on its grid point, mu, the PointMassSettings and the model's
+/// numerics (kModelRevision), not on any feeder: one table serves every feeder and scene with the
+/// same settings, and a table saved after one run (corners()) and added to the next
+/// (addCorners) gives that run bit-identical drifts without running the model again.
 class LocalDriftTable {
  public:
+  /// Grid steps (dimensionless): normal throw Gamma, in-plane throw tau, slopes s1 and s2.
+  static constexpr double kNormalThrowStep = 0.025;
+  static constexpr double kTangentialThrowStep = 0.05;
+  static constexpr double kSlopeStep = 0.02;
+  /// Revision of pointMassDrift's numerics: a saved table records it and a table of another
+  /// revision is refused. Raise it with every change of the model's results.
+  static constexpr int kModelRevision = 1;
+
   explicit LocalDriftTable(PointMassSettings settings = {});
   ~LocalDriftTable();
   LocalDriftTable(const LocalDriftTable&) = delete;
   LocalDriftTable& operator=(const LocalDriftTable&) = delete;
+
+  /// The process's table for `settings` (one per distinct settings, created on first use, kept
+  /// until exit): the scene layer's local laws share it, so that the runs of one process (a
+  /// study, a command with several methods, several feeders of one scene) fill each corner
+  /// once. Thread-safe.
+  static std::shared_ptr<LocalDriftTable> shared(const PointMassSettings& settings = {});
+
+  /// The settings every corner of this table was computed with.
+  const PointMassSettings& settings() const;
+  /// Number of corners computed or added so far.
+  std::size_t numCorners() const;
+  /// Every corner computed or added so far, ordered by (mu, grid): a snapshot to save.
+  std::vector<DriftTableCorner> corners() const;
+  /// Adds corners computed with this table's settings and model revision (a saved table);
+  /// corners already known are kept. Returns how many were new (counted in
+  /// stats().corners_added). Throws std::invalid_argument naming the first bad corner (its
+  /// index in `corners`): non-finite drift, mu non-finite or negative, or a grid index beyond
+  /// +-1e9.
+  std::size_t addCorners(const std::vector<DriftTableCorner>& corners);
 
   /// The interpolated (V1, V2) at `params` (file comment; units |g_n| / w). Where a corner the
   /// interpolation weights is outside the model, the exact model is tried at the point (valid =

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include "rheofeed/output/output.hpp"
 
+#include <unistd.h>
+
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -21,7 +24,11 @@ void writeFileAtomically(const std::filesystem::path& path, const std::string& t
     throw std::runtime_error("cannot create folder " + path.parent_path().string() + ": " +
                              ec.message());
   }
-  const std::filesystem::path tmp = path.string() + ".partial";
+  // A temporary file of this writer's own (process and call): concurrent writers of one path
+  // (sweep jobs sharing a drift table) never write into each other's file; the last rename wins.
+  static std::atomic<unsigned long> calls{0};
+  const std::filesystem::path tmp = path.string() + ".partial." + std::to_string(::getpid()) + "." +
+                                    std::to_string(calls.fetch_add(1));
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw std::runtime_error("cannot open " + tmp.string() + " for writing");

@@ -68,13 +68,16 @@ std::string summaryJson(const RunMetrics& r) {
     json += (k ? ", " : "") + jsonQuoted(r.scene_check[k]);
   }
   const LocalDriftStats& l = h.local_law;  // RunHealth::local_law (simulation.hpp)
-  char d[256];
+  char d[384];
   std::snprintf(d, sizeof d,
                 "{\"feeders\": %d, \"contacts\": %lld, \"wall_contacts\": %lld, "
-                "\"cells_computed\": %lld, \"model_runs\": %lld}",
+                "\"cells_computed\": %lld, \"model_runs\": %lld, \"corners_at_start\": %lld, "
+                "\"corners_added\": %lld}",
                 h.local_law_feeders, static_cast<long long>(l.contacts),
                 static_cast<long long>(l.wall_contacts), static_cast<long long>(l.cells_computed),
-                static_cast<long long>(l.model_runs));
+                static_cast<long long>(l.model_runs),
+                static_cast<long long>(h.local_law_corners_at_start),
+                static_cast<long long>(l.corners_added));
   return json + "], \"feeder\": " + feederJson(r.feeder) + ", \"local_law\": " + d + "}";
 }
 

@@ -536,7 +536,7 @@ MotionLaw rheonomicLaw(const Scene& scene, int fixture) {
         case DriftModel::Local: {
           const LocalVibration v = localVibration(law.vibration, scene.gravity, scene.material.mu);
           v.validate(where + ".law.vibration");
-          return MotionLaw::localVibration(v);
+          return MotionLaw::localVibration(v, LocalDriftTable::shared());
         }
       }
   }

@@ -355,8 +355,14 @@ PartSimulation::PartSimulation(const Scene& scene, Method method)
 MotionLaw PartSimulation::feederLaw(int fixture) {
   MotionLaw law = rheonomicLaw(scene_, fixture);
   if (law.kind() == MotionLaw::Kind::LocalVibration) {
-    local_laws_.push_back(law);
-    health_.local_law_feeders = static_cast<int>(local_laws_.size());
+    ++health_.local_law_feeders;
+    const std::shared_ptr<LocalDriftTable>& table = law.localTable();
+    const bool known = std::any_of(local_tables_.begin(), local_tables_.end(),
+                                   [&](const auto& t) { return t.first == table; });
+    if (!known) {
+      local_tables_.emplace_back(table, table->stats());
+      health_.local_law_corners_at_start += static_cast<std::int64_t>(table->numCorners());
+    }
   }
   return law;
 }
@@ -578,14 +584,15 @@ void PartSimulation::step() {
   const StageClock checks(stage_timing_ ? &stage_times_.checks : nullptr);  // to the end
   time_ = ++steps_ * h;
   health_.steps = steps_;
-  if (!local_laws_.empty()) {
-    LocalDriftStats sum;
-    for (const MotionLaw& law : local_laws_) {
-      const LocalDriftStats s = law.localStats();
-      sum.contacts += s.contacts;
-      sum.wall_contacts += s.wall_contacts;
-      sum.cells_computed += s.cells_computed;
-      sum.model_runs += s.model_runs;
+  if (!local_tables_.empty()) {
+    LocalDriftStats sum;  // this run's share of each table's counts
+    for (const auto& [table, start] : local_tables_) {
+      const LocalDriftStats s = table->stats();
+      sum.contacts += s.contacts - start.contacts;
+      sum.wall_contacts += s.wall_contacts - start.wall_contacts;
+      sum.cells_computed += s.cells_computed - start.cells_computed;
+      sum.model_runs += s.model_runs - start.model_runs;
+      sum.corners_added += s.corners_added - start.corners_added;
     }
     health_.local_law = sum;
   }

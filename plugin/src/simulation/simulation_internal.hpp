@@ -137,7 +137,9 @@ class PartSimulation : public Simulation {
 
   const Method method_;
   const std::vector<PartInstance> instances_;
-  std::vector<MotionLaw> local_laws_;    // rheonomic local laws (copies share their tables)
+  // The distinct drift tables of the local-law feeders (feeders and runs may share one) and their
+  // counts when this run took them: the run reports the difference.
+  std::vector<std::pair<std::shared_ptr<LocalDriftTable>, LocalDriftStats>> local_tables_;
   std::vector<double> part_efficiency_;  // per part family; empty in full-vibration runs
   const SceneLimits limits_;
   std::size_t next_ = 0;

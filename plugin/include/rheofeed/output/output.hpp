@@ -15,7 +15,8 @@ namespace rheofeed::scene {
 
 /// Writes `text` to `path` through a temporary file in the same folder and a rename, creating
 /// the folder if needed. Throws std::runtime_error naming the path on failure (the old file,
-/// if any, is then untouched).
+/// if any, is then untouched). Each call has its own temporary file, so concurrent writers of
+/// one path (threads or processes) leave one writer's whole text, never a mix.
 void writeFileAtomically(const std::filesystem::path& path, const std::string& text);
 
 /// `text` as a JSON string literal (quotes, backslashes and control characters escaped).
@@ -54,7 +55,8 @@ std::string seriesCsv(const RunMetrics& run);
 /// RunHealth, parts_lost, the share of Coulomb fallback steps, the maximum part speed and its
 /// bound, and the list of ignored settings; the scene check's warnings; a "feeder" object
 /// (feederJson); and a "local_law" object (RunHealth::local_law: feeders, contacts,
-/// wall_contacts, cells_computed, model_runs).
+/// wall_contacts, cells_computed, model_runs, corners_added; corners_at_start from
+/// RunHealth::local_law_corners_at_start).
 std::string summaryJson(const RunMetrics& run);
 
 /// Writes <stem>.csv, <stem>.json and, when gnuplot is available, <stem>.png (mean drift vs time

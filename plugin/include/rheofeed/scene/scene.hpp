@@ -300,8 +300,8 @@ LocalVibration localVibration(const Vibration& vibration, const Vec3& gravity, d
 
 /// The motion law a rheonomic method uses for fixture `fixture` of `scene` (None: a stationary
 /// surface). A vibrating fixture gives, by its drift model, the local law
-/// (MotionLaw::localVibration of localVibration(vibration, scene.gravity, scene.material.mu))
-/// or its calibrated drift twist. Throws std::invalid_argument naming the fixture when the
+/// (MotionLaw::localVibration of localVibration(vibration, scene.gravity, scene.material.mu),
+/// on the process's shared drift table LocalDriftTable::shared()) or its calibrated drift twist. Throws std::invalid_argument naming the fixture when the
 /// index is out of range, a calibrated_drift model has no calibrated drift, or a local_sampled
 /// model has no efficiency factors ("run the calibration first").
 MotionLaw rheonomicLaw(const Scene& scene, int fixture);

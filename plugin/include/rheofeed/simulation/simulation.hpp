@@ -132,9 +132,14 @@ struct RunHealth {
   /// local_sampled; 0 when none), and that law's counts summed over them since the start
   /// (MotionLaw::localStats): contacts driven, of which walls (the horizontal surface's drift
   /// used: walls, overhangs, slopes beyond the friction angle), drift table cells filled and
-  /// point-mass model runs. Informative, not a loss: not part of anything().
+  /// point-mass model runs, this run's share when runs share a table (LocalDriftTable::shared:
+  /// a second run of the same vibration in one process runs few or no models). Informative, not
+  /// a loss: not part of anything().
   int local_law_feeders = 0;
   LocalDriftStats local_law;
+  /// Grid corners the local law's tables already held when the run started (from earlier runs of
+  /// the process or a saved table: LocalDriftTable::addCorners).
+  std::int64_t local_law_corners_at_start = 0;
   /// The friction law the engine solved ("cone" or "pyramid"; odeFrictionModel for ODE, the
   /// reference engine always "cone"). Recorded in the run JSON.
   std::string friction_model;

@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: MIT
+// Drift table files (rheofeed/scene/drift_table_file.hpp): a table written and read back gives
+// the same drifts bit for bit without running the point-mass model; files that are not a table
+// of this build's settings, or are malformed, are refused by path and key, adding nothing.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "rheofeed/scene/drift_table_file.hpp"
+#include "rheofeed/scene/scene_io.hpp"
+#include "rheofeed/vibration_drift.hpp"
+
+namespace rheofeed::scene {
+namespace {
+
+namespace fs = std::filesystem;
+
+PointMassSettings coarse() {
+  PointMassSettings s;
+  s.steps_per_cycle = 1024;
+  return s;
+}
+
+fs::path writeText(const std::string& name, const std::string& text) {
+  const fs::path path = fs::temp_directory_path() / ("rheofeed_drift_table_" + name);
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+// A filled table: a few points on and off the grid lines, two friction coefficients.
+std::vector<PointMassParams> fill(LocalDriftTable& table) {
+  std::vector<PointMassParams> points;
+  for (int i = 0; i < 6; ++i) {
+    PointMassParams p;
+    p.normal_throw = 0.4 + 0.27 * i;
+    p.tangential_throw = 1.1 + 0.31 * i;
+    p.slope_along = i % 3 ? 0.013 * i : 0.0;
+    p.slope_across = i % 2 ? 0.021 : 0.0;
+    p.mu = i % 2 ? 0.35 : 0.5;
+    table.drift(p);
+    points.push_back(p);
+  }
+  return points;
+}
+
+// The message of the SceneFileError that loading `path` throws ("" when none).
+std::string loadError(const fs::path& path, LocalDriftTable& table) {
+  try {
+    loadDriftTable(path, table);
+  } catch (const SceneFileError& e) {
+    EXPECT_EQ(e.source(), path.string());
+    return e.what();
+  }
+  return "";
+}
+
+TEST(DriftTableFile, WrittenAndReadBackGivesTheSameDriftsWithoutModelRuns) {
+  LocalDriftTable first(coarse());
+  const std::vector<PointMassParams> points = fill(first);
+  const fs::path path = writeText("roundtrip.json", driftTableJson(first));
+  LocalDriftTable second(coarse());
+  EXPECT_EQ(loadDriftTable(path, second), first.numCorners());
+  for (const PointMassParams& p : points) {
+    EXPECT_EQ(second.drift(p).along, first.drift(p).along);
+    EXPECT_EQ(second.drift(p).across, first.drift(p).across);
+  }
+  EXPECT_EQ(second.stats().model_runs, 0);
+  // Written again, the table is the same text.
+  EXPECT_EQ(driftTableJson(second), driftTableJson(first));
+  fs::remove(path);
+}
+
+TEST(DriftTableFile, RefusesFilesOfOtherSettingsOrMalformed) {
+  LocalDriftTable source(coarse());
+  fill(source);
+  const std::string good = driftTableJson(source);
+  auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string text = good;
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return text.replace(at, from.size(), to);
+  };
+  struct Case {
+    std::string name, text, expected;
+  };
+  const std::vector<Case> cases = {
+      {"syntax.json", "{\"format\": ", "syntax error"},
+      {"scene.json", "{\"name\": \"a scene\"}", "format: must be \"rheofeed local drift table\""},
+      {"revision.json", replaced("\"model_revision\":1", "\"model_revision\":0"),
+       "model_revision: is 0; this build's point-mass model is revision 1"},
+      {"settings.json", replaced("\"steps_per_cycle\":1024", "\"steps_per_cycle\":2048"),
+       "point_mass_settings.steps_per_cycle: is 2048 in the file and 1024 in this build"},
+      {"grid.json", replaced("\"slope\":0.02", "\"slope\":0.01"),
+       "grid_steps.slope: is 0.01 in the file and 0.02 in this build"},
+      {"row.json", replaced("\n[", "\n[1,2,3,"), "corners[0]: must be an array of 8 numbers"},
+      {"valid.json", replaced(",1]\n", ",2]\n"), "][7]: must be 0 or 1, found 2"},
+      {"mu.json", replaced("\n[", "\n[0,0,0,0,-1,0,0,1],\n["), "corner 0: mu = -1"},
+  };
+  for (const Case& c : cases) {
+    const fs::path path = writeText(c.name, c.text);
+    LocalDriftTable table(coarse());
+    const std::string message = loadError(path, table);
+    EXPECT_NE(message.find(path.string()), std::string::npos) << c.name << ": " << message;
+    EXPECT_NE(message.find(c.expected), std::string::npos) << c.name << ": " << message;
+    EXPECT_EQ(table.numCorners(), 0u) << c.name;
+    fs::remove(path);
+  }
+  LocalDriftTable table(coarse());
+  const fs::path missing = fs::temp_directory_path() / "rheofeed_drift_table_missing.json";
+  fs::remove(missing);
+  EXPECT_NE(loadError(missing, table).find("file not found"), std::string::npos);
+  EXPECT_NE(loadError(fs::temp_directory_path(), table).find("directory"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rheofeed::scene
