@@ -6,9 +6,11 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 #include <unordered_map>
 #include <vector>
 
@@ -278,20 +280,58 @@ struct LocalDriftTable::Impl {
   PointMassParams last_params;
   PointMassDrift last_result;
 
-  Corner corner(const CornerKey& key, double mu) {
-    auto it = corners.find(key);
-    if (it != corners.end()) return it->second;
+  int threads = defaultThreads();  // model runs of one cell at a time (setThreads)
+
+  static int defaultThreads() {
+    const unsigned n = std::thread::hardware_concurrency();
+    return n == 0 ? 1 : static_cast<int>(std::min(n, 16u));
+  }
+
+  static PointMassParams cornerParams(const CornerKey& key, double mu) {
     PointMassParams p;
     p.normal_throw = key.i[0] * kThrowStep;
     p.tangential_throw = key.i[1] * kTangentialThrowStep;
     p.slope_along = key.i[2] * kSlopeStep;
     p.slope_across = key.i[3] * kSlopeStep;
     p.mu = mu;
-    const PointMassDrift d = pointMassDrift(p, settings);
-    ++stats.model_runs;
-    Corner c{d.along, d.across, d.valid};
-    corners.emplace(key, c);
-    return c;
+    return p;
+  }
+
+  // Runs the model at the corners of `keys` the table lacks, on up to `threads` threads (the
+  // caller's among them), and adds them. The model is a pure function of its inputs, so the
+  // values do not depend on the number of threads.
+  void fill(const std::vector<CornerKey>& keys, double mu) {
+    std::vector<CornerKey> missing;
+    for (const CornerKey& key : keys) {
+      if (corners.find(key) == corners.end()) missing.push_back(key);
+    }
+    if (missing.empty()) return;
+    std::vector<PointMassDrift> results(missing.size());
+    std::atomic<std::size_t> next{0};
+    std::exception_ptr failure;
+    std::mutex failure_mutex;
+    auto work = [&] {
+      for (std::size_t k = next++; k < missing.size(); k = next++) {
+        try {
+          results[k] = pointMassDrift(cornerParams(missing[k], mu), settings);
+        } catch (...) {  // only std::bad_alloc: pointMassDrift refuses inputs by `valid`
+          const std::lock_guard<std::mutex> lock(failure_mutex);
+          if (!failure) failure = std::current_exception();
+        }
+      }
+    };
+    const std::size_t helpers =
+        std::min(missing.size(), static_cast<std::size_t>(std::max(threads, 1))) - 1;
+    std::vector<std::thread> pool;
+    pool.reserve(helpers);
+    for (std::size_t t = 0; t < helpers; ++t) pool.emplace_back(work);
+    work();
+    for (std::thread& t : pool) t.join();
+    if (failure) std::rethrow_exception(failure);
+    for (std::size_t k = 0; k < missing.size(); ++k) {
+      corners.emplace(missing[k], Corner{results[k].along, results[k].across, results[k].valid});
+    }
+    stats.model_runs += static_cast<std::int64_t>(missing.size());
   }
 };
 
@@ -318,6 +358,20 @@ std::shared_ptr<LocalDriftTable> LocalDriftTable::shared(const PointMassSettings
 
 const PointMassSettings& LocalDriftTable::settings() const {
   return impl_->settings;
+}
+
+void LocalDriftTable::setThreads(int threads) {
+  if (threads < 1) {
+    throw std::invalid_argument("LocalDriftTable::setThreads: " + std::to_string(threads) +
+                                " threads: must be >= 1");
+  }
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->threads = threads;
+}
+
+int LocalDriftTable::threads() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->threads;
 }
 
 std::size_t LocalDriftTable::numCorners() const {
@@ -425,17 +479,28 @@ PointMassDrift LocalDriftTable::drift(const PointMassParams& p) {
       it = s.cells.emplace(key, Cell{}).first;
     }
     Cell& cell = it->second;
+    double weight[16];
+    std::vector<CornerKey> needed;  // weighted corners the cell lacks, run together
+    for (int c = 0; c < 16; ++c) {
+      double w = 1;
+      for (int d = 0; d < 4; ++d) w *= ((c >> d) & 1) ? frac[d] : 1 - frac[d];
+      weight[c] = w;
+      if (w == 0 || ((cell.filled >> c) & 1u)) continue;
+      CornerKey ck = key;
+      for (int d = 0; d < 4; ++d) ck.i[d] += (c >> d) & 1;
+      needed.push_back(ck);
+    }
+    s.fill(needed, p.mu);
     bool valid = true;
     double v1 = 0, v2 = 0;
     for (int c = 0; c < 16 && valid; ++c) {
-      double w = 1;
-      for (int d = 0; d < 4; ++d) w *= ((c >> d) & 1) ? frac[d] : 1 - frac[d];
+      const double w = weight[c];
       if (w == 0) continue;
       const auto k = static_cast<std::size_t>(c);
       if (!((cell.filled >> c) & 1u)) {
         CornerKey ck = key;
         for (int d = 0; d < 4; ++d) ck.i[d] += (c >> d) & 1;
-        cell.corners[k] = s.corner(ck, p.mu);
+        cell.corners[k] = s.corners.at(ck);
         cell.filled |= 1u << c;
       }
       valid = cell.corners[k].valid;

@@ -307,6 +307,17 @@ TEST(LocalDriftTable, RunsOnlyTheCornersAQueryWeights) {
   EXPECT_EQ(table.stats().cells_computed, 1);
 }
 
+// A point inside the table's usual range: hops (Gamma 0.3-2), slopes up to 5.7 degrees.
+PointMassParams randomTablePoint(Lcg& rng, double mu) {
+  PointMassParams p;
+  p.normal_throw = rng.uniform(0.3, 2.0);
+  p.tangential_throw = rng.uniform(0.5, 3.0);
+  p.slope_along = rng.uniform(-0.1, 0.1);
+  p.slope_across = rng.uniform(0.0, 0.1);
+  p.mu = mu;
+  return p;
+}
+
 // A table's corners carried into another table (a saved table read by the next run) give the
 // same drifts, bit for bit, with no model run; corners it already has are kept; a bad corner is
 // refused by its index and nothing of the batch is added.
@@ -317,12 +328,7 @@ TEST(LocalDriftTable, CornersCarriedIntoAnotherTableGiveTheSameDriftsWithoutMode
   Lcg rng(11);
   std::vector<PointMassParams> points;
   for (int i = 0; i < 12; ++i) {
-    PointMassParams p;
-    p.normal_throw = rng.uniform(0.3, 2.0);
-    p.tangential_throw = rng.uniform(0.5, 3.0);
-    p.slope_along = rng.uniform(-0.1, 0.1);
-    p.slope_across = rng.uniform(0.0, 0.1);
-    p.mu = i % 2 ? 0.4 : 0.6;
+    const PointMassParams p = randomTablePoint(rng, i % 2 ? 0.4 : 0.6);
     points.push_back(p);
     ASSERT_TRUE(first.drift(p).valid) << "point " << i;
   }
@@ -356,6 +362,26 @@ TEST(LocalDriftTable, CornersCarriedIntoAnotherTableGiveTheSameDriftsWithoutMode
   bad[1] = corners[1];
   bad[1].mu = -0.5;
   EXPECT_THROW(third.addCorners(bad), std::invalid_argument);
+}
+
+// The corners of a lookup run on several threads: the same values, bit for bit, as on one.
+TEST(LocalDriftTable, ThreadsDoNotChangeTheValues) {
+  PointMassSettings settings;
+  settings.steps_per_cycle = 1024;
+  LocalDriftTable serial(settings), parallel(settings);
+  serial.setThreads(1);
+  parallel.setThreads(4);
+  EXPECT_EQ(parallel.threads(), 4);
+  Lcg rng(3);
+  for (int i = 0; i < 10; ++i) {
+    const PointMassParams p = randomTablePoint(rng, 0.5);
+    const PointMassDrift a = serial.drift(p), b = parallel.drift(p);
+    EXPECT_EQ(a.valid, b.valid) << "point " << i;
+    EXPECT_EQ(a.along, b.along) << "point " << i;
+    EXPECT_EQ(a.across, b.across) << "point " << i;
+  }
+  EXPECT_EQ(serial.stats().model_runs, parallel.stats().model_runs);
+  EXPECT_THROW(parallel.setThreads(0), std::invalid_argument);
 }
 
 // The scene layer's laws share one table per settings in a process; other settings get their

@@ -46,7 +46,8 @@
 /// contacts.
 ///
 /// ## Cost
-/// pointMassDrift takes milliseconds (PointMassSettings). LocalDriftTable fills a grid in
+/// pointMassDrift takes milliseconds (PointMassSettings); the corners one lookup needs run on
+/// several threads at once (LocalDriftTable::setThreads). LocalDriftTable fills a grid in
 /// (Gamma, tau, s1, s2) lazily, the corners of a cell (up to 16) as contacts need them, and
 /// interpolates multilinearly in the cell (a corner of weight 0 - an input on a grid line, as
 /// s1 = s2 = 0 on a level floor - is not run); a contact whose inputs equal the previous contact's
@@ -195,6 +196,11 @@ class LocalDriftTable {
   /// once. Thread-safe.
   static std::shared_ptr<LocalDriftTable> shared(const PointMassSettings& settings = {});
 
+  /// Threads that run the model at the corners one lookup needs (up to 16 per cell, about 5 ms
+  /// each; the caller's thread is one of them): >= 1, 1 runs them in the caller's thread. The
+  /// values do not depend on it. Default: the machine's hardware threads, at most 16.
+  void setThreads(int threads);
+  int threads() const;
   /// The settings every corner of this table was computed with.
   const PointMassSettings& settings() const;
   /// Number of corners computed or added so far.
