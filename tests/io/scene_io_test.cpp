@@ -142,6 +142,7 @@ void expectSameScene(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.solver.iterations, b.solver.iterations);
   EXPECT_EQ(a.solver.ode_quickstep, b.solver.ode_quickstep);
   EXPECT_EQ(a.solver.friction, b.solver.friction);
+  EXPECT_EQ(a.solver.broad_phase, b.solver.broad_phase);
   EXPECT_EQ(a.solver.erp, b.solver.erp);
   EXPECT_EQ(a.solver.cfm, b.solver.cfm);
   EXPECT_EQ(a.solver.tolerance, b.solver.tolerance);
@@ -300,6 +301,7 @@ Scene everyFieldScene() {
   s.solver.apgd = false;
   s.solver.coulomb_iterations = 3;
   s.solver.friction = FrictionModel::Pyramid;  // a Dantzig scene may ask for the pyramid
+  s.solver.broad_phase = BroadPhase::SweepAndPrune;
   s.outputs.conveying_direction = {0, 1, 0};
   s.outputs.angular_drift = true;
   s.outputs.axis_origin = {-3, 0, 0};
@@ -628,6 +630,19 @@ TEST(SceneFileErrors, BadLawAndShapeNamesAreExplained) {
           "needs an array of 1");
   refused(replaced(kGood, R"("duration": 1)", R"("duration": 1, "format_version": 2)"),
           "format_version", "reads version 1");
+}
+
+TEST(SceneFileErrors, UnknownBroadPhaseIsExplained) {
+  auto withSolver = [](const std::string& solver) {
+    return replaced(kGood, R"("duration": 1)", R"("duration": 1, "solver": {)" + solver + "}");
+  };
+  refused(withSolver(R"("broad_phase": "sap")"), "solver.broad_phase",
+          "unknown broad phase \"sap\"");
+  refused(withSolver(R"("broad_phase": "sweep-and-prune")"), "solver.broad_phase",
+          "did you mean \"sweep_and_prune\"");
+  refused(withSolver(R"("broad_phase": 2)"), "solver.broad_phase", "expected a string");
+  const Scene s = parseScene(withSolver(R"("broad_phase": "hash")"), "hash.json");
+  EXPECT_EQ(s.solver.broad_phase, BroadPhase::Hash);
 }
 
 TEST(SceneFileErrors, BadDriftModelAndEfficiencyAreExplained) {

@@ -8,6 +8,8 @@
 
 #include <ode/ode.h>
 
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -62,6 +64,31 @@ TEST(CollisionSpace, ReportsEveryWallContactOfTheCrowdedTrough) {
   dSpaceDestroy(space);                // destroys its geoms (cleanup mode on)
   EXPECT_EQ(counts.touching, 13 * 9);  // the grid lies 2 mm inside the wall: all touch
   EXPECT_EQ(counts.missed, 0);
+}
+
+// Each broad phase a scene can ask for (solver.broad_phase) reports every wall contact; the hash
+// space is refused, naming the missing fix, on an ODE whose hash space would miss them.
+TEST(CollisionSpace, EachBroadPhaseReportsEveryWallContactOrIsRefused) {
+  dInitODE2(0);
+  for (BroadPhase phase : {BroadPhase::Hash, BroadPhase::SweepAndPrune}) {
+    SCOPED_TRACE(toString(phase));
+    if (phase == BroadPhase::Hash && !odeHashSpaceIsSound()) {
+      try {
+        createCollisionSpace(nullptr, phase);
+        ADD_FAILURE() << "the stock hash space was given";
+      } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("patches/0004"), std::string::npos) << e.what();
+      }
+      continue;
+    }
+    dSpaceID space = createCollisionSpace(nullptr, phase);
+    EXPECT_EQ(dSpaceGetClass(space),
+              phase == BroadPhase::Hash ? dHashSpaceClass : dSweepAndPruneSpaceClass);
+    const Counts counts = sweepWallFace(space);
+    dSpaceDestroy(space);
+    EXPECT_EQ(counts.touching, 13 * 9);
+    EXPECT_EQ(counts.missed, 0);
+  }
 }
 
 // The reason for createCollisionSpace: the stock hash space misses the pairs above z = 0 in the

@@ -15,9 +15,17 @@
 /// sweep-and-prune space (dSweepAndPruneSpaceCreate, all three axes; exact, O(n log n)) on a
 /// stock ODE. Applications that build their own space on a stock ODE should do the same, or
 /// use dSimpleSpace for small scenes.
+///
+/// The two are equally exact and differ in cost and in the order in which they hand out pairs
+/// (which moves a chaotic crowd's trajectory, not its statistics): on the main demo's trough at
+/// 1000 and 2000 parts, over 4 and 4 seeds, they lost and sank as many parts, and sweep-and-prune
+/// took 10-25 % less CPU per step (its collision stage 2.4x cheaper at 2000 parts;
+/// demos/results/crowd_leaks.md, section 6). Scenes choose with solver.broad_phase.
 #pragma once
 
 #include <ode/ode.h>
+
+#include <stdexcept>
 
 namespace rheofeed {
 
@@ -34,6 +42,30 @@ inline bool odeHashSpaceIsSound() {
 inline dSpaceID createCollisionSpace(dSpaceID parent) {
   if (odeHashSpaceIsSound()) return dHashSpaceCreate(parent);
   return dSweepAndPruneSpaceCreate(parent, dSAP_AXES_XYZ);
+}
+
+/// A broad phase createCollisionSpace can be asked for.
+enum class BroadPhase {
+  Hash,           ///< dHashSpaceCreate: only where odeHashSpaceIsSound()
+  SweepAndPrune,  ///< dSweepAndPruneSpaceCreate(parent, dSAP_AXES_XYZ): any ODE
+};
+/// Printable (and scene file) name: "hash" or "sweep_and_prune".
+inline const char* toString(BroadPhase broad_phase) {
+  return broad_phase == BroadPhase::Hash ? "hash" : "sweep_and_prune";
+}
+
+/// The space of `broad_phase`. Throws std::invalid_argument for Hash on an ODE whose hash
+/// space misses pairs (no patches/0004): it would let parts through fixtures.
+inline dSpaceID createCollisionSpace(dSpaceID parent, BroadPhase broad_phase) {
+  if (broad_phase == BroadPhase::SweepAndPrune) {
+    return dSweepAndPruneSpaceCreate(parent, dSAP_AXES_XYZ);
+  }
+  if (!odeHashSpaceIsSound()) {
+    throw std::invalid_argument(
+        "broad phase hash: the linked ODE's hash space misses pairs (it lacks rheofeed's "
+        "patches/0004-hash-space-cell-slots); use sweep_and_prune");
+  }
+  return dHashSpaceCreate(parent);
 }
 
 }  // namespace rheofeed

@@ -591,6 +591,19 @@ Scene readScene(const json& root) {
     if (m.opt("speculative_contacts", speculative)) x.speculative_contacts = speculative;
     bool warm_start = true;
     if (m.opt("warm_start", warm_start)) x.warm_start = warm_start;
+    std::string broad_phase;
+    if (m.opt("broad_phase", broad_phase)) {
+      if (broad_phase == "hash") {
+        x.broad_phase = BroadPhase::Hash;
+      } else if (broad_phase == "sweep_and_prune") {
+        x.broad_phase = BroadPhase::SweepAndPrune;
+      } else {
+        const std::string typo = closest(broad_phase, {"hash", "sweep_and_prune"});
+        fail(m.at("broad_phase"), "unknown broad phase \"" + broad_phase + "\"" +
+                                      (typo.empty() ? "" : " (did you mean \"" + typo + "\"?)") +
+                                      "; expected hash or sweep_and_prune");
+      }
+    }
     m.finish();
   }
   o.opt("duration", s.duration, Range::Positive);

@@ -197,6 +197,7 @@ std::string toJson(const Scene& scene) {
   if (x.rheonomic_time_step != 0) out["solver"]["rheonomic_time_step"] = x.rheonomic_time_step;
   if (x.friction) out["solver"]["friction"] = toString(*x.friction);
   if (x.speculative_contacts) out["solver"]["speculative_contacts"] = *x.speculative_contacts;
+  if (x.broad_phase) out["solver"]["broad_phase"] = toString(*x.broad_phase);
   if (x.warm_start) out["solver"]["warm_start"] = *x.warm_start;
   const Outputs& o = scene.outputs;
   const Outputs defaults;

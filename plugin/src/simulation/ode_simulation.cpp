@@ -31,6 +31,10 @@ class OdeSimulation final : public PartSimulation {
   OdeSimulation(const Scene& scene, Method method) : PartSimulation(scene, method) {
     static const bool initialised = (dInitODE2(0), true);
     (void)initialised;
+    // First: a broad phase this ODE cannot give is refused before anything is allocated.
+    space_ = scene.solver.broad_phase
+                 ? rheofeed::createCollisionSpace(nullptr, *scene.solver.broad_phase)
+                 : rheofeed::createCollisionSpace(nullptr);
     world_ = dWorldCreate();
     dWorldSetGravity(world_, scene.gravity.x, scene.gravity.y, scene.gravity.z);
     dWorldSetERP(world_, scene.solver.erp);
@@ -38,7 +42,6 @@ class OdeSimulation final : public PartSimulation {
     dWorldSetQuickStepNumIterations(world_, scene.solver.iterations);
     dWorldSetContactMaxCorrectingVel(world_, scene.solver.max_correcting_velocity);
     dWorldSetContactSurfaceLayer(world_, scene.solver.surface_layer);
-    space_ = rheofeed::createCollisionSpace(nullptr);
     const FrictionModel friction = odeFrictionModel(scene.solver);
     health_.friction_model = toString(friction);
     FeederSet::Options options;

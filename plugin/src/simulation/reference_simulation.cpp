@@ -25,6 +25,7 @@ class ReferenceSimulation final : public PartSimulation {
     reference::Settings s;
     s.gravity = scene.gravity;
     s.erp = scene.solver.erp;
+    s.broad_phase = scene.solver.broad_phase;
     s.cfm = scene.solver.cfm;
     s.default_mu = scene.material.mu;
     s.restitution = scene.material.restitution;  // Newton's impact law, as ODE's dContactBounce

@@ -51,10 +51,12 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "rheofeed/ccp/settings.hpp"
+#include "rheofeed/collision_space.hpp"
 #include "rheofeed/motion_law.hpp"
 #include "rheofeed/vec3.hpp"
 
@@ -161,6 +163,10 @@ struct Settings {
   bool nsgs_top_down = true;
   /// Use the dense Delassus matrix up to this many contacts, matrix-free above.
   int dense_contact_limit = 100;
+  /// The world's broad phase (collision_space.hpp). Unset: createCollisionSpace's choice (the
+  /// hash space where the linked ODE has rheofeed's fix, else sweep-and-prune). Hash on an ODE
+  /// without the fix is refused by the constructor.
+  std::optional<BroadPhase> broad_phase;
 };
 
 /// Friction coefficient for a pair of geoms (dimensionless, >= 0).

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "rheofeed/collision_space.hpp"
 #include "rheofeed/friction_model.hpp"
 #include "rheofeed/motion_law.hpp"
 #include "rheofeed/vec3.hpp"
@@ -239,6 +240,13 @@ struct SolverSettings {
   /// true with ode_quickstep = false (a direct solver) and in the reference engine is an
   /// ignored setting.
   std::optional<bool> warm_start;
+  /// Both engines' broad phase (collision_space.hpp; JSON "hash" or "sweep_and_prune"). Unset:
+  /// the hash space where the linked ODE has rheofeed's fix (patches/0004), else
+  /// sweep-and-prune (createCollisionSpace). Both pair every overlapping pair; sweep-and-prune
+  /// costs less in crowds of a thousand parts and more (measured in
+  /// demos/results/crowd_leaks.md, section 6). "hash" on an ODE without the fix is refused by
+  /// the simulation.
+  std::optional<BroadPhase> broad_phase;
 };
 
 /// The four methods.
@@ -301,9 +309,10 @@ LocalVibration localVibration(const Vibration& vibration, const Vec3& gravity, d
 /// The motion law a rheonomic method uses for fixture `fixture` of `scene` (None: a stationary
 /// surface). A vibrating fixture gives, by its drift model, the local law
 /// (MotionLaw::localVibration of localVibration(vibration, scene.gravity, scene.material.mu),
-/// on the process's shared drift table LocalDriftTable::shared()) or its calibrated drift twist. Throws std::invalid_argument naming the fixture when the
-/// index is out of range, a calibrated_drift model has no calibrated drift, or a local_sampled
-/// model has no efficiency factors ("run the calibration first").
+/// on the process's shared drift table LocalDriftTable::shared()) or its calibrated drift twist.
+/// Throws std::invalid_argument naming the fixture when the index is out of range, a
+/// calibrated_drift model has no calibrated drift, or a local_sampled model has no efficiency
+/// factors ("run the calibration first").
 MotionLaw rheonomicLaw(const Scene& scene, int fixture);
 
 /// True when `law` is a vibration whose drift model (DriftModel) lacks its data for a rheonomic
