@@ -29,6 +29,7 @@ struct RunArgs {
   /// before the runs when the file exists and written back, with the corners the runs added,
   /// after them; empty: none.
   std::string drift_table;
+  bool drift_table_given = false;
 };
 int runCommand(const RunArgs& args);
 

@@ -110,11 +110,13 @@ int main(int argc, char** argv) {
                  "<method>.glb (glTF 2.0, opens in Blender) and view.html, which plays it in a "
                  "browser beside the plots")
       ->default_str("off");
-  run_cmd->add_option(
-      "--drift-table", run.drift_table,
-      "the local vibration law's table of point-mass results (JSON): read before the runs when "
-      "FILE exists, written back after them with what they added, so that later runs of the "
-      "scene skip those model runs (same drifts, bit for bit)");
+  run_cmd
+      ->add_option(
+          "--drift-table", run.drift_table,
+          "the local vibration law's table of point-mass results (JSON): read before the runs when "
+          "FILE exists, written back after them with what they added, so that later runs of the "
+          "scene skip those model runs (same drifts, bit for bit)")
+      ->each([&run](const std::string&) { run.drift_table_given = true; });
   addCalibrateOptions(run_cmd, run.calibrate);
 
   CalibrateArgs cal;

@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: MIT
 // `rheofeed run SCENE`.
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -79,53 +82,148 @@ void plotRuns(const std::vector<std::pair<std::string, std::string>>& blocks,
 
 namespace {
 
-// --drift-table: the shared table's corners from FILE, when it exists (a bad file is bad input).
-void openDriftTable(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (!std::filesystem::exists(file, ec)) {
-    const std::filesystem::path folder =
-        file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
-    if (!std::filesystem::is_directory(folder, ec)) {
-      throw std::invalid_argument("--drift-table " + file.string() + ": the folder " +
-                                  folder.string() + " does not exist");
+// --drift-table FILE: the process's drift table (LocalDriftTable::shared) read before the runs
+// and written back after them.
+class DriftTableFile {
+ public:
+  // Checks FILE against the plan and the output folder `out` (a refusal is bad input:
+  // std::invalid_argument naming --drift-table) and reads it when it exists and a run of the
+  // plan uses the local vibration law; else says up front that it is ignored.
+  DriftTableFile(const std::string& file, const Plan& plan, const std::filesystem::path& out) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (file.empty()) throw std::invalid_argument("--drift-table \"\": must name a file");
+    path_ = file;
+    for (int k = 0; k < 40 && fs::is_symlink(path_, ec); ++k) {  // write through links
+      const fs::path target = fs::read_symlink(path_, ec);
+      path_ = target.is_absolute() ? target : path_.parent_path() / target;
     }
-    std::fprintf(stderr,
-                 "rheofeed run: drift table %s does not exist yet: it is written after the runs\n",
-                 file.string().c_str());
-    return;
+    const std::string name = "--drift-table " + file;
+    used_ = usesLocalLaw(plan);
+    if (!used_) {
+      std::fprintf(stderr,
+                   "rheofeed run: %s ignored: no run of this command uses the local vibration "
+                   "law (the file is neither read nor written)\n",
+                   name.c_str());
+      return;
+    }
+    const fs::path folder = path_.has_parent_path() ? path_.parent_path() : fs::path(".");
+    const fs::path filename = path_.filename();
+    // In --out (created before the runs): any name but the runs' own outputs.
+    const bool in_out = fs::weakly_canonical(folder, ec) == fs::weakly_canonical(out, ec);
+    if (in_out && isRunOutput(filename.string(), plan)) {
+      throw std::invalid_argument(name + ": the run writes " + filename.string() + " into --out " +
+                                  out.string() + "; give the table another name or folder");
+    }
+    if (!in_out && !fs::exists(folder, ec)) {
+      throw std::invalid_argument(name + ": the folder " + folder.string() + " does not exist");
+    }
+    if (!in_out && !fs::is_directory(folder, ec)) {
+      throw std::invalid_argument(name + ": " + folder.string() + " is not a folder");
+    }
+    if (!fs::exists(path_, ec)) {
+      if (!in_out) {  // --out is checked by prepareOutputFolder
+        const fs::path probe = folder / (".rheofeed_write_test_" + std::to_string(::getpid()));
+        std::FILE* f = std::fopen(probe.string().c_str(), "w");
+        if (!f) {
+          throw std::invalid_argument(name + ": the folder " + folder.string() +
+                                      " is not writable");
+        }
+        std::fclose(f);
+        fs::remove(probe, ec);
+      }
+      std::fprintf(stderr,
+                   "rheofeed run: drift table %s does not exist yet: it is written after the "
+                   "runs\n",
+                   file.c_str());
+      return;
+    }
+    try {
+      const std::size_t read = loadDriftTable(path_, *LocalDriftTable::shared());
+      std::fprintf(stderr, "rheofeed run: drift table %s: %zu point-mass corners read\n",
+                   file.c_str(), read);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("--drift-table: " + std::string(e.what()) +
+                                  " (delete the file to start a new table)");
+    }
+    known_ = LocalDriftTable::shared()->numCorners();
   }
-  LocalDriftTable& table = *LocalDriftTable::shared();
-  const std::size_t added = loadDriftTable(file, table);
-  std::fprintf(stderr, "rheofeed run: drift table %s: %zu point-mass corners read\n",
-               file.string().c_str(), added);
-}
 
-// After the runs: the shared table written back to FILE (atomically), or why not.
-void saveDriftTable(const std::filesystem::path& file, bool used) {
-  if (!used) {
-    std::fprintf(stderr,
-                 "rheofeed run: --drift-table %s ignored: no run used the local vibration law "
-                 "(the file is left as it was)\n",
-                 file.string().c_str());
-    return;
+  // After the runs: corners another process wrote meanwhile are merged in, then the table is
+  // written back (atomically) when it grew. Throws std::runtime_error naming --drift-table
+  // when it cannot be written (the runs' own outputs are written before).
+  void save() {
+    if (!used_) return;
+    LocalDriftTable& table = *LocalDriftTable::shared();
+    std::error_code ec;
+    if (std::filesystem::exists(path_, ec)) {
+      try {
+        loadDriftTable(path_, table);
+      } catch (const std::invalid_argument& e) {
+        std::fprintf(stderr, "rheofeed run: --drift-table: %s: replaced by this run's table\n",
+                     e.what());
+      }
+    }
+    const std::size_t corners = table.numCorners();
+    if (corners == known_ && std::filesystem::exists(path_, ec)) {
+      std::fprintf(stderr, "rheofeed run: drift table %s unchanged: %zu point-mass corners\n",
+                   path_.string().c_str(), corners);
+      return;
+    }
+    try {
+      writeFileAtomically(path_, driftTableJson(table));
+    } catch (const std::exception& e) {
+      throw std::runtime_error("--drift-table " + path_.string() +
+                               ": the table could not be written: " + e.what());
+    }
+    std::fprintf(stderr, "rheofeed run: drift table %s written: %zu point-mass corners (%zu new)\n",
+                 path_.string().c_str(), corners, corners - known_);
   }
-  const LocalDriftTable& table = *LocalDriftTable::shared();
-  writeFileAtomically(file, driftTableJson(table));
-  std::fprintf(stderr, "rheofeed run: drift table %s written: %zu point-mass corners\n",
-               file.string().c_str(), table.numCorners());
-}
+
+ private:
+  // A rheonomic run of a vibrating fixture on the local law (local or local_sampled).
+  static bool usesLocalLaw(const Plan& plan) {
+    for (const PlannedRun& r : plan.runs) {
+      if (isFullVibration(r.method)) continue;
+      for (const Fixture& f : r.scene.fixtures) {
+        if (f.law.kind == FeederLaw::Kind::Vibration &&
+            (f.law.drift_model == DriftModel::Local ||
+             f.law.drift_model == DriftModel::LocalSampled)) {
+          return true;
+        }
+      }
+    }
+    return false;
+  }
+  // A file name the runs of `plan` write into --out.
+  static bool isRunOutput(const std::string& name, const Plan& plan) {
+    for (const char* fixed : {"mean_height.png", "methods.png", "view.html", "three"}) {
+      if (name == fixed) return true;
+    }
+    for (const PlannedRun& r : plan.runs) {
+      if (name.rfind(toString(r.method), 0) == 0) return true;
+    }
+    return false;
+  }
+
+  std::filesystem::path path_;  // FILE with symbolic links followed
+  bool used_ = false;
+  std::size_t known_ = 0;  // corners after reading FILE
+};
 
 }  // namespace
 
 int runCommand(const RunArgs& args) {
   Plan plan;
   std::filesystem::path out;
+  std::unique_ptr<DriftTableFile> table;
   try {
     plan = makePlan(args.scene, {"ode_rheonomic"});
     out = !args.out_given ? std::filesystem::path("out") / plan.name
                           : std::filesystem::path(args.out);
+    if (args.drift_table_given)
+      table = std::make_unique<DriftTableFile>(args.drift_table, plan, out);
     prepareOutputFolder(out, "--out");
-    if (!args.drift_table.empty()) openDriftTable(args.drift_table);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rheofeed run: %s\n", e.what());
     return 2;
@@ -170,7 +268,6 @@ int runCommand(const RunArgs& args) {
         unit.c_str());
     std::fflush(stdout);
     std::vector<std::pair<std::string, std::string>> blocks;
-    bool any_local_law = false;
     for (std::size_t k = 0; k < plan.runs.size(); ++k) {
       const PlannedRun& run = plan.runs[k];
       const Method m = run.method;
@@ -192,14 +289,12 @@ int runCommand(const RunArgs& args) {
       if (recorder) recorder->write(out / (toString(m) + std::string(".glb")));
       blocks.emplace_back(toString(m), seriesCsv(r));
       const RunHealth& h = r.health;
-      any_local_law = any_local_law || h.local_law_feeders > 0;
       std::printf("| %s | %.3g | %d | %.5f | %.5f | %.4f | %.2f | %.2f | %.4f | %d | %.1f %% |\n",
                   toString(m), r.time_step, r.parts, r.mean_drift, r.mean_drift_ci95,
                   r.vertical_displacement, r.throughput, r.cpu_seconds, r.real_time_factor,
                   h.partsLost(), 100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps));
       std::fflush(stdout);
     }
-    if (!args.drift_table.empty()) saveDriftTable(args.drift_table, any_local_law);
     if (blocks.size() > 1) {
       plotRuns(blocks, plan.scene.name + ": methods compared", "mean drift (" + unit + ")", "1:3",
                (out / "methods.png").string());
@@ -218,6 +313,7 @@ int runCommand(const RunArgs& args) {
       std::printf("animation (%s): open %s\n", toString(plan.runs[0].method),
                   page.string().c_str());
     }
+    if (table) table->save();  // last: a table that cannot be written costs no other output
   });
 }
 

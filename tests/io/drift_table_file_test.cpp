@@ -97,7 +97,14 @@ TEST(DriftTableFile, RefusesFilesOfOtherSettingsOrMalformed) {
        "grid_steps.slope: is 0.01 in the file and 0.02 in this build"},
       {"row.json", replaced("\n[", "\n[1,2,3,"), "corners[0]: must be an array of 8 numbers"},
       {"valid.json", replaced(",1]\n", ",2]\n"), "][7]: must be 0 or 1, found 2"},
-      {"mu.json", replaced("\n[", "\n[0,0,0,0,-1,0,0,1],\n["), "corner 0: mu = -1"},
+      {"mu.json", replaced("\n[", "\n[0,0,0,0,-1,0,0,1],\n["), "corners[0][4]: mu must be >= 0"},
+      {"negative.json", replaced("\n[", "\n[-5,0,0,0,0.5,0,0,1],\n["),
+       "corners[0][0]: must be >= 0, found -5"},
+      {"twice.json", replaced("\n[", "\n[0,0,0,0,0.5,0,0,1],\n[0,0,0,0,0.5,1,0,1],\n["),
+       "corners[1]: the same grid point and mu as corners[0]"},
+      {"unknown.json", replaced("\"format\"", "\"note\":1,\"format\""), "note: unknown key"},
+      {"columns.json", replaced("\"valid\"]", "\"ok\"]"), "columns: must be ["},
+      {"no_grid.json", replaced("\"grid_steps\"", "\"grid\""), "grid_steps: is missing"},
   };
   for (const Case& c : cases) {
     const fs::path path = writeText(c.name, c.text);

@@ -152,6 +152,9 @@ TEST(OdeVsReference, PileOnBeltIsCarriedWithEitherBroadPhase) {
       EXPECT_THROW(makeSimulation(s, Method::OdeRheonomic), std::invalid_argument);
       continue;
     }
+    for (Method m : {Method::OdeRheonomic, Method::ReferenceRheonomic}) {  // recorded
+      EXPECT_EQ(makeSimulation(s, m)->health().broad_phase, toString(phase)) << toString(m);
+    }
     const Comparison c = compare(s, Method::OdeRheonomic, Method::ReferenceRheonomic);
     for (const RunSummary* r : {&c.a, &c.b}) {
       SCOPED_TRACE(toString(r->method));

@@ -17,10 +17,11 @@
 /// use dSimpleSpace for small scenes.
 ///
 /// The two are equally exact and differ in cost and in the order in which they hand out pairs
-/// (which moves a chaotic crowd's trajectory, not its statistics): on the main demo's trough at
-/// 1000 and 2000 parts, over 4 and 4 seeds, they lost and sank as many parts, and sweep-and-prune
-/// took 10-25 % less CPU per step (its collision stage 2.4x cheaper at 2000 parts;
-/// demos/results/crowd_leaks.md, section 6). Scenes choose with solver.broad_phase.
+/// (which moves a chaotic crowd's trajectory): on the main demo's trough at 1000 and 2000 parts,
+/// 4 seeds each, sweep-and-prune took 10-25 % less CPU per step (its collision stage 2.4x
+/// cheaper at 2000 parts) and its losses were not distinguishable from the hash space's (35
+/// against 24 parts through a fixture in 8 runs; demos/results/crowd_leaks.md, section 6).
+/// Scenes choose with solver.broad_phase.
 #pragma once
 
 #include <ode/ode.h>

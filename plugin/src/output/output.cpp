@@ -42,8 +42,9 @@ void writeFileAtomically(const std::filesystem::path& path, const std::string& t
   }
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
+    const std::string why = ec.message();
     std::filesystem::remove(tmp, ec);
-    throw std::runtime_error("cannot rename " + tmp.string() + " to " + path.string());
+    throw std::runtime_error("cannot rename " + tmp.string() + " to " + path.string() + ": " + why);
   }
 }
 

@@ -38,7 +38,8 @@ std::string summaryJson(const RunMetrics& r) {
   for (std::size_t k = 0; k < r.drift_models.size(); ++k) {
     run += (k ? ", " : "") + jsonQuoted(r.drift_models[k]);
   }
-  run += "], \"friction\": " + jsonQuoted(r.health.friction_model);
+  run += "], \"friction\": " + jsonQuoted(r.health.friction_model) +
+         ", \"broad_phase\": " + jsonQuoted(r.health.broad_phase);
   const RunHealth& h = r.health;
   char c[1536];
   std::snprintf(
@@ -71,13 +72,11 @@ std::string summaryJson(const RunMetrics& r) {
   char d[384];
   std::snprintf(d, sizeof d,
                 "{\"feeders\": %d, \"contacts\": %lld, \"wall_contacts\": %lld, "
-                "\"cells_computed\": %lld, \"model_runs\": %lld, \"corners_at_start\": %lld, "
-                "\"corners_added\": %lld}",
+                "\"cells_computed\": %lld, \"model_runs\": %lld, \"corners_at_start\": %lld}",
                 h.local_law_feeders, static_cast<long long>(l.contacts),
                 static_cast<long long>(l.wall_contacts), static_cast<long long>(l.cells_computed),
                 static_cast<long long>(l.model_runs),
-                static_cast<long long>(h.local_law_corners_at_start),
-                static_cast<long long>(l.corners_added));
+                static_cast<long long>(h.local_law_corners_at_start));
   return json + "], \"feeder\": " + feederJson(r.feeder) + ", \"local_law\": " + d + "}";
 }
 

@@ -4,10 +4,12 @@
 // never mixes its values into a run.
 #include "rheofeed/scene/drift_table_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <sstream>
+#include <tuple>
 #include <vector>
 
 #include "rheofeed/scene/scene_io.hpp"
@@ -35,9 +37,21 @@ json gridJson() {
               {"slope", LocalDriftTable::kSlopeStep}};
 }
 
+json columnsJson() {
+  return json{"normal_throw_index",
+              "tangential_throw_index",
+              "slope_along_index",
+              "slope_across_index",
+              "mu",
+              "along",
+              "across",
+              "valid"};
+}
+
 // Throws naming `key` when the file's object `found` differs from the table's `expected`.
 void requireSame(const std::string& file, const std::string& key, const json& found,
                  const json& expected) {
+  if (found.is_null()) throw SceneFileError(file, key, "is missing");
   if (!found.is_object()) {
     throw SceneFileError(file, key, "must be an object, found " + io::describe(found));
   }
@@ -69,6 +83,11 @@ DriftTableCorner readCorner(const std::string& file, std::size_t index, const js
                            "must be an integer grid index, found " + io::describe(v));
     }
     c.grid[d] = v.get<std::int64_t>();
+    // Gamma, tau and s2 (mirror symmetry: only s2 >= 0 is tabulated) are never negative.
+    if (d != 2 && c.grid[d] < 0) {
+      throw SceneFileError(file, where + "[" + std::to_string(d) + "]",
+                           "must be >= 0, found " + std::to_string(c.grid[d]));
+    }
   }
   double values[3];
   for (int k = 0; k < 3; ++k) {
@@ -82,6 +101,9 @@ DriftTableCorner readCorner(const std::string& file, std::size_t index, const js
   c.mu = values[0];
   c.along = values[1];
   c.across = values[2];
+  if (!(c.mu >= 0)) {
+    throw SceneFileError(file, where + "[4]", "mu must be >= 0, found " + io::show(c.mu));
+  }
   const json& valid = row[7];
   if (!valid.is_number_integer() ||
       (valid.get<std::int64_t>() != 0 && valid.get<std::int64_t>() != 1)) {
@@ -98,9 +120,7 @@ std::string driftTableJson(const LocalDriftTable& table) {
                     {"model_revision", LocalDriftTable::kModelRevision},
                     {"point_mass_settings", settingsJson(table.settings())},
                     {"grid_steps", gridJson()},
-                    {"columns",
-                     {"normal_throw_index", "tangential_throw_index", "slope_along_index",
-                      "slope_across_index", "mu", "along", "across", "valid"}}};
+                    {"columns", columnsJson()}};
   std::string text = header.dump();
   text.pop_back();  // the closing brace: the corners follow, one per line
   text += ",\n\"corners\": [";
@@ -153,6 +173,16 @@ std::size_t parseDriftTable(const std::string& text, const std::string& file,
   requireSame(file, "point_mass_settings", doc.value("point_mass_settings", json()),
               settingsJson(table.settings()));
   requireSame(file, "grid_steps", doc.value("grid_steps", json()), gridJson());
+  if (doc.value("columns", json()) != columnsJson()) {
+    throw SceneFileError(file, "columns", "must be " + columnsJson().dump());
+  }
+  for (const auto& [key, value] : doc.items()) {
+    (void)value;
+    if (key != "format" && key != "model_revision" && key != "point_mass_settings" &&
+        key != "grid_steps" && key != "columns" && key != "corners") {
+      throw SceneFileError(file, key, "unknown key");
+    }
+  }
   const auto rows = doc.find("corners");
   if (rows == doc.end() || !rows->is_array()) {
     throw SceneFileError(file, "corners", "must be an array of corners");
@@ -160,6 +190,23 @@ std::size_t parseDriftTable(const std::string& text, const std::string& file,
   std::vector<DriftTableCorner> corners;
   corners.reserve(rows->size());
   for (std::size_t k = 0; k < rows->size(); ++k) corners.push_back(readCorner(file, k, (*rows)[k]));
+  // The same grid point twice: a table written by driftTableJson never has it.
+  std::vector<std::size_t> order(corners.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  auto key = [&](std::size_t k) {
+    const DriftTableCorner& c = corners[k];
+    return std::make_tuple(c.mu, c.grid[0], c.grid[1], c.grid[2], c.grid[3]);
+  };
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return key(a) < key(b) || (key(a) == key(b) && a < b);
+  });
+  for (std::size_t k = 1; k < order.size(); ++k) {
+    if (key(order[k]) == key(order[k - 1])) {
+      throw SceneFileError(
+          file, "corners[" + std::to_string(order[k]) + "]",
+          "the same grid point and mu as corners[" + std::to_string(order[k - 1]) + "]");
+    }
+  }
   try {
     return table.addCorners(corners);
   } catch (const std::invalid_argument& e) {

@@ -44,6 +44,8 @@ class OdeSimulation final : public PartSimulation {
     dWorldSetContactSurfaceLayer(world_, scene.solver.surface_layer);
     const FrictionModel friction = odeFrictionModel(scene.solver);
     health_.friction_model = toString(friction);
+    health_.broad_phase = toString(
+        dSpaceGetClass(space_) == dHashSpaceClass ? BroadPhase::Hash : BroadPhase::SweepAndPrune);
     FeederSet::Options options;
     options.friction = friction;
     feeders_ = std::make_unique<FeederSet>(options);

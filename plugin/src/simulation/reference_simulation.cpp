@@ -182,6 +182,9 @@ class ReferenceSimulation final : public PartSimulation {
   // defaults.
   void listIgnoredSettings() {
     health_.friction_model = "cone";
+    health_.broad_phase =
+        toString(dSpaceGetClass(world_->space()) == dHashSpaceClass ? BroadPhase::Hash
+                                                                    : BroadPhase::SweepAndPrune);
     if (scene_.solver.friction == FrictionModel::Pyramid) {
       ignoreSetting(
           "solver.friction = pyramid: ignored by the reference solver (it solves the cone)");

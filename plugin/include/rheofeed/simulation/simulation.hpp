@@ -143,6 +143,9 @@ struct RunHealth {
   /// The friction law the engine solved ("cone" or "pyramid"; odeFrictionModel for ODE, the
   /// reference engine always "cone"). Recorded in the run JSON.
   std::string friction_model;
+  /// The broad phase the engine's collision space is ("hash" or "sweep_and_prune";
+  /// SolverSettings::broad_phase, collision_space.hpp). Recorded in the run JSON.
+  std::string broad_phase;
   /// ODE runs with speculative contacts (SolverSettings::speculative_contacts): contacts made
   /// across a gap over the run (summed over steps; 0 when off and for the reference engine).
   /// Informative, not a loss.
