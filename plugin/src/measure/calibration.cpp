@@ -31,6 +31,16 @@ Scene sampleScene(const Scene& scene, int fixture, int family, int parts, int st
   sample.parts = {scene.parts[static_cast<std::size_t>(family)]};
   sample.parts[0].count = std::min(parts, sample.parts[0].count);
   sample.parts[0].rate = 0;
+  // A spawn region made for parts poured one at a time (the bowl of primitives) may not hold
+  // them all at t = 0: as many as it holds are sampled (the count is in the calibration's `how`).
+  while (sample.parts[0].count > 1) {
+    try {
+      (void)drawParts(sample);
+      break;
+    } catch (const std::invalid_argument&) {
+      --sample.parts[0].count;
+    }
+  }
   for (Fixture& f : sample.fixtures) f.law.efficiency.clear();
   sample.solver.time_step = 1.0 / (v.frequency * steps_per_cycle);
   sample.duration = (warmup_cycles + measure_cycles) / v.frequency;
@@ -74,7 +84,7 @@ Calibration calibrateBySampling(const Scene& scene, int fixture,
   c.fixture = fixture;
   c.how = std::string("full-vibration sample (") +
           (settings.use_reference_solver ? "reference" : "ODE") + ", " +
-          std::to_string(settings.sample_parts) + " parts)";
+          std::to_string(sample.parts[0].count) + " parts)";
   const std::clock_t start = std::clock();
   const bool screw = v.torsion_amplitude != 0;
   const RunMetrics m = measureRun(sample, method);

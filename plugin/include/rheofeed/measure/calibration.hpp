@@ -25,7 +25,8 @@ namespace rheofeed::scene {
 
 /// How the sampling calibration runs.
 struct CalibrationSettings {
-  int sample_parts = 8;        ///< parts in the sample (spawned at t = 0 in the scene's region)
+  int sample_parts = 8;        ///< parts in the sample (spawned at t = 0 in the scene's region;
+                               ///< fewer when the region does not hold them all: see `how`)
   int steps_per_cycle = 200;   ///< full-vibration time step = 1 / (f steps_per_cycle)
   double warmup_cycles = 25;   ///< cycles before measuring
   double measure_cycles = 75;  ///< cycles measured
@@ -66,7 +67,8 @@ Scene withCalibration(Scene scene, const Calibration& calibration);
 
 /// How calibrateEfficiency runs (issue 8: the part's own efficiency under the local law).
 struct EfficiencySettings {
-  int sample_parts = 8;  ///< parts of the family in the sample (>= 1), spawned at t = 0
+  int sample_parts = 8;  ///< parts of the family in the sample (>= 1), spawned at t = 0 (fewer
+                         ///< when the spawn region does not hold them all: see `how`)
   /// Full-vibration time step = 1 / (f steps_per_cycle) (>= 4). 1000 by default: at 200 the
   /// sampled drift on an inclined track is off by up to 10 % (issue 8), at 1000 it is not.
   int steps_per_cycle = 1000;
