@@ -180,14 +180,22 @@ void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out) {
       hz.kind = Hazard::Kind::MassRatio;
       hz.value = ratio;
       hz.limit = limit;
-      hz.where = idx("parts", c.heavy_family) + ".size, " + idx("parts", c.light_family) +
-                 ".size, density, solver.iterations, solver.time_step";
+      const bool one_family = c.heavy_family == c.light_family;
+      hz.where = idx("parts", c.heavy_family) + ".size, " +
+                 (one_family ? std::string() : idx("parts", c.light_family) + ".size, ") +
+                 "density, solver.iterations, solver.time_step";
       const double x = c.light_thickness / (c.g * c.h * c.h);
       std::ostringstream m;
-      m << "the heaviest part (" << idx("parts", c.heavy_family) << ", " << fmt(c.heaviest)
-        << " kg) is " << fmt(ratio) << " times the lightest (" << idx("parts", c.light_family)
-        << ", " << fmt(c.lightest) << " kg, " << mm(c.light_thickness) << " thick); "
-        << (quickstep ? (warm ? "ODE quickstep (warm starts)" : "ODE quickstep")
+      if (one_family) {  // the size distribution's bounds
+        m << "the heaviest part " << idx("parts", c.heavy_family) << " can draw ("
+          << fmt(c.heaviest) << " kg) is " << fmt(ratio) << " times its lightest ("
+          << fmt(c.lightest) << " kg, " << mm(c.light_thickness) << " thick); ";
+      } else {
+        m << "the heaviest part (" << idx("parts", c.heavy_family) << ", " << fmt(c.heaviest)
+          << " kg) is " << fmt(ratio) << " times the lightest (" << idx("parts", c.light_family)
+          << ", " << fmt(c.lightest) << " kg, " << mm(c.light_thickness) << " thick); ";
+      }
+      m << (quickstep ? (warm ? "ODE quickstep (warm starts)" : "ODE quickstep")
                       : "the reference solver")
         << " with " << k << " iterations at h = " << fmt(c.h)
         << " s (thickness / (g h^2) = " << fmt(x)
