@@ -110,7 +110,10 @@ class DriftTableFile {
     const fs::path folder = path_.has_parent_path() ? path_.parent_path() : fs::path(".");
     const fs::path filename = path_.filename();
     // In --out (created before the runs): any name but the runs' own outputs.
-    const bool in_out = fs::weakly_canonical(folder, ec) == fs::weakly_canonical(out, ec);
+    std::error_code ec_folder, ec_out;  // a path that cannot be resolved is not --out
+    const fs::path resolved_folder = fs::weakly_canonical(folder, ec_folder);
+    const fs::path resolved_out = fs::weakly_canonical(out, ec_out);
+    const bool in_out = !ec_folder && !ec_out && resolved_folder == resolved_out;
     if (in_out && isRunOutput(filename.string(), plan)) {
       throw std::invalid_argument(name + ": the run writes " + filename.string() + " into --out " +
                                   out.string() + "; give the table another name or folder");

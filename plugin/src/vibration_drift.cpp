@@ -479,16 +479,18 @@ PointMassDrift LocalDriftTable::drift(const PointMassParams& p) {
       it = s.cells.emplace(key, Cell{}).first;
     }
     Cell& cell = it->second;
+    auto cornerKey = [&key](int c) {  // corner c of the cell: bit d steps along input d
+      CornerKey ck = key;
+      for (int d = 0; d < 4; ++d) ck.i[d] += (c >> d) & 1;
+      return ck;
+    };
     double weight[16];
     std::vector<CornerKey> needed;  // weighted corners the cell lacks, run together
     for (int c = 0; c < 16; ++c) {
       double w = 1;
       for (int d = 0; d < 4; ++d) w *= ((c >> d) & 1) ? frac[d] : 1 - frac[d];
       weight[c] = w;
-      if (w == 0 || ((cell.filled >> c) & 1u)) continue;
-      CornerKey ck = key;
-      for (int d = 0; d < 4; ++d) ck.i[d] += (c >> d) & 1;
-      needed.push_back(ck);
+      if (w != 0 && !((cell.filled >> c) & 1u)) needed.push_back(cornerKey(c));
     }
     s.fill(needed, p.mu);
     bool valid = true;
@@ -498,9 +500,7 @@ PointMassDrift LocalDriftTable::drift(const PointMassParams& p) {
       if (w == 0) continue;
       const auto k = static_cast<std::size_t>(c);
       if (!((cell.filled >> c) & 1u)) {
-        CornerKey ck = key;
-        for (int d = 0; d < 4; ++d) ck.i[d] += (c >> d) & 1;
-        cell.corners[k] = s.corners.at(ck);
+        cell.corners[k] = s.corners.at(cornerKey(c));
         cell.filled |= 1u << c;
       }
       valid = cell.corners[k].valid;

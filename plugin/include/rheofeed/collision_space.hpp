@@ -26,6 +26,7 @@
 
 #include <ode/ode.h>
 
+#include <optional>
 #include <stdexcept>
 
 namespace rheofeed {
@@ -35,14 +36,6 @@ namespace rheofeed {
 inline bool odeHashSpaceIsSound() {
   static const bool sound = dCheckConfiguration("ODE_EXT_hash_space_cells") != 0;
   return sound;
-}
-
-/// A new top-level (parent null) or child space that pairs every overlapping pair of geoms:
-/// dHashSpaceCreate(parent) when odeHashSpaceIsSound(), else
-/// dSweepAndPruneSpaceCreate(parent, dSAP_AXES_XYZ). Destroy it with dSpaceDestroy.
-inline dSpaceID createCollisionSpace(dSpaceID parent) {
-  if (odeHashSpaceIsSound()) return dHashSpaceCreate(parent);
-  return dSweepAndPruneSpaceCreate(parent, dSAP_AXES_XYZ);
 }
 
 /// A broad phase createCollisionSpace can be asked for.
@@ -55,10 +48,17 @@ inline const char* toString(BroadPhase broad_phase) {
   return broad_phase == BroadPhase::Hash ? "hash" : "sweep_and_prune";
 }
 
-/// The space of `broad_phase`. Throws std::invalid_argument for Hash on an ODE whose hash
-/// space misses pairs (no patches/0004): it would let parts through fixtures.
-inline dSpaceID createCollisionSpace(dSpaceID parent, BroadPhase broad_phase) {
-  if (broad_phase == BroadPhase::SweepAndPrune) {
+/// A new top-level (parent null) or child space that pairs every overlapping pair of geoms:
+/// the one of `broad_phase`, or when it is unset dHashSpaceCreate(parent) where
+/// odeHashSpaceIsSound() and dSweepAndPruneSpaceCreate(parent, dSAP_AXES_XYZ) elsewhere.
+/// Throws std::invalid_argument for BroadPhase::Hash on an ODE whose hash space misses pairs
+/// (no patches/0004): it would let parts through fixtures. Destroy it with dSpaceDestroy.
+inline dSpaceID createCollisionSpace(dSpaceID parent,
+                                     std::optional<BroadPhase> broad_phase = std::nullopt) {
+  if (!broad_phase) {
+    broad_phase = odeHashSpaceIsSound() ? BroadPhase::Hash : BroadPhase::SweepAndPrune;
+  }
+  if (*broad_phase == BroadPhase::SweepAndPrune) {
     return dSweepAndPruneSpaceCreate(parent, dSAP_AXES_XYZ);
   }
   if (!odeHashSpaceIsSound()) {
@@ -67,6 +67,11 @@ inline dSpaceID createCollisionSpace(dSpaceID parent, BroadPhase broad_phase) {
         "patches/0004-hash-space-cell-slots); use sweep_and_prune");
   }
   return dHashSpaceCreate(parent);
+}
+
+/// The broad phase of a space createCollisionSpace made (for reporting).
+inline BroadPhase broadPhaseOf(dSpaceID space) {
+  return dSpaceGetClass(space) == dHashSpaceClass ? BroadPhase::Hash : BroadPhase::SweepAndPrune;
 }
 
 }  // namespace rheofeed

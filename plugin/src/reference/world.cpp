@@ -81,9 +81,7 @@ World::World(const Settings& settings) : impl_(std::make_unique<WorldState>()) {
   // ODE's collision module must be initialised once per process before any geom is used.
   static const bool ode_initialised = (dInitODE2(0), true);
   (void)ode_initialised;
-  impl_->space = settings.broad_phase
-                     ? rheofeed::createCollisionSpace(nullptr, *settings.broad_phase)
-                     : rheofeed::createCollisionSpace(nullptr);
+  impl_->space = rheofeed::createCollisionSpace(nullptr, settings.broad_phase);
 }
 
 World::~World() {

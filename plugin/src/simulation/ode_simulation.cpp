@@ -32,9 +32,7 @@ class OdeSimulation final : public PartSimulation {
     static const bool initialised = (dInitODE2(0), true);
     (void)initialised;
     // First: a broad phase this ODE cannot give is refused before anything is allocated.
-    space_ = scene.solver.broad_phase
-                 ? rheofeed::createCollisionSpace(nullptr, *scene.solver.broad_phase)
-                 : rheofeed::createCollisionSpace(nullptr);
+    space_ = rheofeed::createCollisionSpace(nullptr, scene.solver.broad_phase);
     world_ = dWorldCreate();
     dWorldSetGravity(world_, scene.gravity.x, scene.gravity.y, scene.gravity.z);
     dWorldSetERP(world_, scene.solver.erp);
@@ -44,8 +42,7 @@ class OdeSimulation final : public PartSimulation {
     dWorldSetContactSurfaceLayer(world_, scene.solver.surface_layer);
     const FrictionModel friction = odeFrictionModel(scene.solver);
     health_.friction_model = toString(friction);
-    health_.broad_phase = toString(
-        dSpaceGetClass(space_) == dHashSpaceClass ? BroadPhase::Hash : BroadPhase::SweepAndPrune);
+    health_.broad_phase = toString(broadPhaseOf(space_));
     FeederSet::Options options;
     options.friction = friction;
     feeders_ = std::make_unique<FeederSet>(options);

@@ -182,9 +182,7 @@ class ReferenceSimulation final : public PartSimulation {
   // defaults.
   void listIgnoredSettings() {
     health_.friction_model = "cone";
-    health_.broad_phase =
-        toString(dSpaceGetClass(world_->space()) == dHashSpaceClass ? BroadPhase::Hash
-                                                                    : BroadPhase::SweepAndPrune);
+    health_.broad_phase = toString(broadPhaseOf(world_->space()));
     if (scene_.solver.friction == FrictionModel::Pyramid) {
       ignoreSetting(
           "solver.friction = pyramid: ignored by the reference solver (it solves the cone)");
