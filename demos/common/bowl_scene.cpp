@@ -45,7 +45,8 @@ constexpr double kWall = 0.010;            // wall thickness
 constexpr double kWallHeight = 0.100;      // wall top above z = 0
 constexpr double kFloorTop = 0.010;        // floor surface
 constexpr double kConeInner = 0.010;       // central cone: flat cap inside this radius
-constexpr double kConeOuter = 0.124;       // the cone meets the floor here
+constexpr double kConeOuter = 0.130;       // the cone meets the floor here, at the ramp's inner
+                                           // edge: no gutter where nuts circle past its start
 constexpr double kConeSlope = 25 * kDeg;   // > atan(mu): nuts slide off it to the wall
 constexpr double kTrackWidth = 0.020;      // ramp: r = 130..150 mm
 constexpr double kTrackThickness = 0.012;  // a nut falling 30 mm from the turn above must not pass
@@ -60,10 +61,14 @@ constexpr double kOutletLength = 0.125;       // straight outlet track, tangent 
 constexpr double kOutletWallTop = 0.064;      // the wall is cut down to this where it exits
 constexpr double kExitRadius = 0.175;         // the exit plane: tangent to this circle at 45 deg
 
+// The ramp starts 1 mm below the floor's top, so that it rises out of the floor (over the first
+// 12 degrees) instead of starting at a step a nut's rim can catch on.
+constexpr double kRampStart = kFloorTop - 0.001;
+
 // Height of the ramp's top surface on its centre line at azimuth phi (rad, from +x, counted on
 // along the ramp: phi in [0, 2 pi kTurns]).
 double trackTop(double phi) {
-  return kFloorTop + kPitch * phi / (2 * kPi);
+  return kRampStart + kPitch * phi / (2 * kPi);
 }
 
 double trackCentre() {
@@ -138,8 +143,10 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
                            Pose::axisAngle({0, 0, 1}, 0, {0, 0, kFloorTop - 0.010})));
   addCone(bowl, 36);
 
-  // Wall: 48 upright boxes; with the outlet, the boxes it passes over are cut down.
-  const Fixture wall = boxRing("wall", 48, kInnerRadius + 0.5 * kWall, kInnerRadius, kWall,
+  // Wall: 192 upright boxes (facets 1.9 degrees apart, their joints 0.02 mm proud; with 48 the
+  // joints stood 0.3 mm proud and stopped nuts in full vibration, demos/results/bowl_feeder.md);
+  // with the outlet, the boxes it passes over are cut down.
+  const Fixture wall = boxRing("wall", 192, kInnerRadius + 0.5 * kWall, kInnerRadius, kWall,
                                kWallHeight, 0.5 * kWallHeight);
   for (Fixture::Geom g : wall.geoms) {
     const double azimuth = std::atan2(g.pose.position.y, g.pose.position.x);
@@ -158,7 +165,7 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
   ramp.pitch = kPitch;
   ramp.turns = kTurns;
   ramp.segments_per_turn = kTrackSegments;
-  ramp.z_start = kFloorTop;
+  ramp.z_start = kRampStart;
   ramp.outward_tilt = kTrackTilt;
   for (const Fixture::Geom& g : helicalTrack(ramp)) bowl.geoms.push_back(g);
 
@@ -184,9 +191,12 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
     // Return chute: a plate under the wiper's drop zone, from just below the ramp's inner
     // edge down inwards at 35 degrees (> atan(mu), so nuts slide) to the cone. A wiped nut
     // falls about 10 mm onto it instead of 50 mm onto the cone's foot (1 m/s, 10 mm per step:
-    // its centre crossed the cone's surface for a step).
-    const double chute_slope = 35 * kDeg, chute_thickness = 0.012;
-    const double r_top = kInnerRadius - kTrackWidth - 0.001;
+    // its centre crossed the cone's surface for a step). Its top edge stays 5 mm inside the
+    // ramp's inner edge and it is 6 mm thick and 50 mm wide, so that no part of it hangs lower
+    // than 7 mm over the turn below (a 12 mm plate 70 mm wide reached down to that track's top
+    // and jammed the nuts climbing under it).
+    const double chute_slope = 35 * kDeg, chute_thickness = 0.006;
+    const double r_top = kInnerRadius - kTrackWidth - 0.005;
     const double z_top = trackTop(phi0) - kTrackThickness - 0.003;
     // Where the plate's top meets the cone: z_top - (r_top - r) tan(chute) = cone(r).
     const double r_meet =
@@ -199,7 +209,7 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
                          Vec3{0, 0, z_top - 0.5 * run * std::tan(chute_slope)};
     const Vec3 up_normal = std::sin(chute_slope) * inward + Vec3{0, 0, std::cos(chute_slope)};
     // Rz(azimuth + pi) Ry(chute): local x runs down the plate, inwards; local z is its normal.
-    bowl.geoms.push_back(box({run / std::cos(chute_slope), 0.070, chute_thickness},
+    bowl.geoms.push_back(box({run / std::cos(chute_slope), 0.050, chute_thickness},
                              composed(Pose::axisAngle({0, 0, 1}, chute_az + kPi),
                                       Pose::axisAngle({0, 1, 0}, chute_slope),
                                       top_mid - 0.5 * chute_thickness * up_normal)));
@@ -256,11 +266,11 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
   p.random_orientation = true;
   p.count = nuts;
   p.rate = rate;
-  // Dropped one by one onto the cone (at r = 90..102 mm, where its surface is 20..26 mm high)
-  // from at most 12 mm above it: a nut falling further moves more than its thickness in a step
+  // Dropped one by one onto the cone (at r = 90..102 mm, where its surface is 23..29 mm high)
+  // from at most 14 mm above it: a nut falling further moves more than its thickness in a step
   // of 0.01 s and can pass into the cone's boxes before its first contact.
-  p.spawn_min = {0.0, -0.100, 0.032};
-  p.spawn_max = {0.02, -0.090, 0.034};
+  p.spawn_min = {0.0, -0.100, 0.0348};
+  p.spawn_max = {0.02, -0.090, 0.0368};
   s.parts.push_back(p);
   s.material.mu = 0.3;
   s.solver.time_step = 0.0002;  // full vibration: 100 steps per period
