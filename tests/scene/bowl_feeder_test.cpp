@@ -27,7 +27,7 @@ constexpr double kDeg = kPi / 180;
 // on along the ramp) and the radius at which nuts ride it (leaning on the wall: the track falls
 // 3 degrees outwards; a nut of radius 5.25 mm against the wall at 150 mm).
 double rampTop(double phi) {
-  return 0.010 + 0.030 * phi / (2 * kPi);
+  return 0.009 + 0.030 * phi / (2 * kPi);  // from 1 mm below the floor's top (10 mm)
 }
 constexpr double kRideRadius = 0.1447;      // m
 constexpr double kWiperClearance = 0.0065;  // m, above the track (documented in the header)
