@@ -47,7 +47,9 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->check(CLI::IsMember(rheofeed::demo::driftModelStudyScenes()));
   app.add_option("--ref-steps-per-cycle", dm.reference_steps_per_cycle,
-                 "--drift-models: steps per vibration cycle of the full-vibration judge")
+                 "--drift-models: steps per vibration cycle of the full-vibration judge (not for "
+                 "bowl_primitives, whose judge steps with its scene file's solver.time_step, nor "
+                 "for scenes with a judge step of their own: each says so on stderr)")
       ->capture_default_str()
       ->check(CLI::Range(100, 100000));
   app.add_option("--bowl-scene", dm.bowl_scene, "--drift-models: the bowl's scene file")

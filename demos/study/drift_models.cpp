@@ -364,6 +364,15 @@ int runDriftModelStudy(const DriftModelStudyOptions& o) {
                           : o.quick                         ? 400
                                                             : o.reference_steps_per_cycle;
       r.judge_steps_per_cycle = ref_spc;
+      if (!o.quick && ref_spc != o.reference_steps_per_cycle) {
+        std::fprintf(stderr,
+                     "%s: the judge runs at %d steps per cycle, %s; --ref-steps-per-cycle = %d "
+                     "does not apply to it\n",
+                     entry.name.c_str(), ref_spc,
+                     byBowlPhase(entry) ? "its scene file's solver.time_step"
+                                        : "this scene's own judge step",
+                     o.reference_steps_per_cycle);
+      }
       // The scene's own rheonomic step where it gives one (the bowl: 0.005 s, its trimesh
       // floor lets nuts tunnel at 0.01 s), else the study's.
       StepOverrides study_step;

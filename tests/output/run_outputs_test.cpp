@@ -122,6 +122,16 @@ TEST(SeriesCsv, OneRowPerSampleReadsBackAsTheSeries) {
   }
 }
 
+TEST(SeriesCsv, AnAngularDriftNamesItsUnitRadiansPerSecond) {
+  RunMetrics r = run();
+  r.angular = true;
+  const auto rows = csvRows(seriesCsv(r));
+  ASSERT_GE(rows.size(), 1u);
+  ASSERT_GE(rows[0].size(), 4u);
+  EXPECT_EQ(rows[0][2], "mean_drift_radps");
+  EXPECT_EQ(rows[0][3], "ci95_radps");
+}
+
 TEST(SummaryJson, ParsesToTheRunMetricsWritten) {
   const RunMetrics r = run();
   const std::string text = summaryJson(r);

@@ -11,8 +11,12 @@ namespace rheofeed::scene {
 
 std::string seriesCsv(const RunMetrics& run) {
   std::ostringstream s;
-  s << "time_s,parts,mean_velocity_mps,ci95_mps,mean_height_m,exited,lost_fell,"
-       "lost_through_fixture,lost_out_of_bounds,lost_nonfinite,lost_too_fast,lost_left_feeder\n";
+  // The drift's unit in its column names: m/s along the conveying direction, or rad/s about
+  // the angular drift's axis.
+  s << (run.angular ? "time_s,parts,mean_drift_radps,ci95_radps,"
+                    : "time_s,parts,mean_velocity_mps,ci95_mps,")
+    << "mean_height_m,exited,lost_fell,lost_through_fixture,lost_out_of_bounds,lost_nonfinite,"
+       "lost_too_fast,lost_left_feeder\n";
   char line[256];
   for (const DriftSample& d : run.series) {
     std::snprintf(line, sizeof line, "%.6f,%d,%.8g,%.8g,%.8g,%d,%d,%d,%d,%d,%d,%d\n", d.time,

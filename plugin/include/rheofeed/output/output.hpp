@@ -46,9 +46,11 @@ std::vector<std::string> writeFeederOutputs(const FeederMetrics& feeder,
                                             const std::filesystem::path& folder,
                                             const std::string& stem, const std::string& title);
 
-/// CSV of the series: time_s,parts,mean_velocity_mps,ci95_mps,mean_height_m,exited, then the
-/// parts lost so far by kind (cumulative counts, RunHealth): lost_fell,lost_through_fixture,
-/// lost_out_of_bounds,lost_nonfinite,lost_too_fast.
+/// CSV of the series: time_s,parts,mean_velocity_mps,ci95_mps (the mean drift along the conveying
+/// direction, m/s, and its 95 % half-width; for an angular drift mean_drift_radps,ci95_radps, rad/s
+/// about its axis),mean_height_m,exited, then the parts lost so far by kind (cumulative counts,
+/// RunHealth): lost_fell,lost_through_fixture,lost_out_of_bounds,lost_nonfinite,lost_too_fast,
+/// lost_left_feeder.
 std::string seriesCsv(const RunMetrics& run);
 
 /// One-line JSON summary of a run: all scalar fields, a "health" object with every count of
