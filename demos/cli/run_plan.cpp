@@ -86,9 +86,17 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
       "scene " + plan.file.string() +
       (args.duration_given ? " with --duration " + formatNumber(args.duration) + " s"
                            : std::string()) +
-      (args.warmup_given ? " with --warmup " + formatNumber(args.warmup) + " s" : std::string());
+      (args.warmup_given ? " with --warmup " + formatNumber(args.warmup) + " s" : std::string()) +
+      (args.dt_given ? " with --dt " + formatNumber(args.dt) + " s" : std::string());
   try {
-    scene.validate();
+    // With --dt every run steps with it: the scene's duration and step limits are checked
+    // against it, not against steps the runs will not take.
+    Scene checked = scene;
+    if (args.dt_given) {
+      checked.solver.time_step = args.dt;
+      checked.solver.rheonomic_time_step = 0;
+    }
+    checked.validate();
   } catch (const std::invalid_argument& e) {
     std::string hint;
     if (args.duration_given && !args.warmup_given &&
@@ -107,6 +115,14 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
     const double h = step.time_step;
     run.step_source = step.source();
     run.scene = atRunStep(scene, step);
+    try {
+      run.scene.validate();
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("method ") + toString(m) +
+                                  " at h = " + formatNumber(h) + " s (" + run.step_source + "), " +
+                                  where + ": " + e.what());
+    }
+    // Said only of a run that will go ahead.
     if (run.scene.outputs.sample_interval != scene.outputs.sample_interval) {
       std::fprintf(stderr,
                    "rheofeed: %s: outputs.sample_interval = %s s is shorter than this run's step "
@@ -114,13 +130,6 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
                    toString(m), formatNumber(scene.outputs.sample_interval).c_str(),
                    formatNumber(h).c_str(), run.step_source.c_str(),
                    formatNumber(run.scene.outputs.sample_interval).c_str());
-    }
-    try {
-      run.scene.validate();
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string("method ") + toString(m) +
-                                  " at h = " + formatNumber(h) + " s (" + run.step_source + "), " +
-                                  where + ": " + e.what());
     }
     plan.runs.push_back(std::move(run));
   }
