@@ -680,7 +680,9 @@ std::vector<PartInstance> drawParts(const Scene& scene) {
                                         "].spawn_min/spawn_max: "
                                         "region too small for " +
                                         std::to_string(spec.count) +
-                                        " parts spawned at t = 0 without overlap");
+                                        " parts spawned at t = 0 without overlap (rate = 0 "
+                                        "spawns them all at once; a rate > 0, parts/s, spawns "
+                                        "them one after another)");
           }
           p.pose.position = pos;
           if (p.spawn_time == 0) placed.emplace_back(pos, bound);
