@@ -58,12 +58,13 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
     insertComment(
         json, "{",
         "The bowl feeder built from ODE primitives (`rheofeed run bowl_feeder_fill`; written by "
-        "dump_builtin_scene from builtin_scenes.hpp bowlFeederScene(240, 6, true, 120)). 240 M6 "
+        "dump_builtin_scene from builtin_scenes.hpp bowlFeederScene(240, 6, true, 300)). 240 M6 "
         "nuts are poured onto the central cone at 6 parts/s (40 s); they slide to the wall, are "
         "carried round and up a 2-turn helical ramp by the bowl's screw vibration, meet a wiper on "
         "the last turn that pushes nuts not lying flat (on edge, or riding on another nut) back "
-        "into the bowl over a return chute, and leave lying flat through a tangential outlet. "
-        "Outputs: output rate and cumulative count at the exit plane, first part out, exit "
+        "into the bowl over a return chute, and leave lying flat through a tangential outlet. The "
+        "rheonomic runs use the local vibration law (no calibration). Outputs: output rate and "
+        "cumulative count at the exit plane, first part out, exit "
         "orientation, mean height against time, angular drift. Numbers and commands: "
         "demos/results/bowl_feeder.md.");
   } else {
@@ -72,9 +73,9 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
         "The bowl feeder built from ODE primitives with 12 M6 nuts (`rheofeed run "
         "bowl_feeder_primitives`; written by dump_builtin_scene from builtin_scenes.hpp "
         "bowlFeederScene()): the same bowl, tooling and outlet as bowl_feeder_fill. Rheonomic at "
-        "h = 0.01 s (the paper's step) with no nut lost or sunk in 60 s, where the mesh bowl of "
-        "bowl_feeder.json loses 5 of 12 in 12 s at that step. Numbers and commands: "
-        "demos/results/bowl_feeder.md.");
+        "h = 0.01 s (the paper's step) on the local vibration law, with no nut lost or sunk in 60 "
+        "s, where the mesh bowl of bowl_feeder.json loses 5 of 12 in 12 s at that step. Numbers "
+        "and commands: demos/results/bowl_feeder.md.");
   }
   insertComment(
       json, "\"name\": \"bowl\",",
@@ -104,13 +105,12 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
   insertComment(
       json, "\"law\": {",
       "Screw vibration at 50 Hz: 0.15 mm vertical (1.5 g: the nuts hop) and 0.17 degrees torsion "
-      "(0.13 m/s peak at r = 140 mm), as bowl_feeder.json. calibrated_drift: 0.313 rad/s about "
-      "+z, bowl_feeder.json's calibration on its ramp (same vibration, mu and nut size), not "
-      "re-measured on this bowl. This bowl's own full vibration (ODE, friction cone) turns 12 "
-      "nuts at 0.28 rad/s on the floor and 0.12-0.18 rad/s on the ramp (falling as its step is "
-      "refined), so the rheonomic feed rate on the ramp is not yet the vibrated bowl's; the local "
-      "law (--drift-model local) is within 10 % on the floor and 22 % slow on the ramp "
-      "(demos/results/bowl_local_law.md, last section).");
+      "(0.13 m/s peak at r = 140 mm), as bowl_feeder.json. drift_model local: the rheonomic runs "
+      "use the local vibration law, no calibration; against this bowl's own full vibration (ODE, "
+      "friction cone) at 2000 steps per cycle it is within 1 % on the floor and on the ramp "
+      "(demos/results/bowl_local_law.md, last section). calibrated_drift: 0.313 rad/s about +z, "
+      "bowl_feeder.json's calibration on its ramp, kept for `--drift-model calibrated_drift`; it "
+      "is not this bowl's (its runs are 13 % fast on the floor and 2-3x on the ramp).");
   insertComment(json, "\"name\": \"m6_nuts\",",
                 "M6 nut blanks (10 mm across flats, 5 mm thick, 2.3 g with the 6 mm hole) as ODE "
                 "cylinders of the hexagon's area (radius 5.25 mm), thickness 5 mm, density 5290 "
@@ -119,8 +119,9 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
                 "degrees): a nut falling further moves more than its thickness per step of 0.01 "
                 "s. Orientation: +z or -z up is lying flat.");
   insertComment(json, "\"solver\": {",
-                "time_step 0.2 ms: 100 steps per vibration period, for full-vibration runs (the "
-                "ramp's drift is not converged at this step: demos/results/bowl_local_law.md). "
+                "time_step 0.2 ms: 100 steps per vibration period, for full-vibration runs; the "
+                "ramp's drift converges only at 1000-2000 steps per cycle (0.01-0.02 ms; "
+                "demos/results/bowl_local_law.md). "
                 "rheonomic_time_step 0.01 s, the paper's bowl step.");
   insertComment(json, "\"outputs\": {",
                 "angular drift about +z (rad/s) after 1 s; the exit plane is tangent to r = 175 "
@@ -142,7 +143,7 @@ int main(int argc, char** argv) {
   using namespace rheofeed::scene;
   try {
     const bool fill = name == "bowl_feeder_fill";
-    const Scene scene = fill ? bowlFeederScene(240, 6, true, 120) : bowlFeederScene();
+    const Scene scene = fill ? bowlFeederScene(240, 6, true, 300) : bowlFeederScene();
     std::string json = toJson(scene);
     commentBowl(json, scene, fill);
     std::cout << json;

@@ -82,14 +82,15 @@ std::vector<Fixture::Geom> helicalTrack(const HelicalTrack& track);
 /// 192 boxes (10 mm thick, 100 mm high), and a helical ramp of 128 boxes (20 mm wide, r =
 /// 130..150 mm, 12 mm thick, pitch 30 mm, 2 turns counter-clockwise rising out of the floor at
 /// azimuth 0, its top falling 3 degrees towards the wall). Screw vibration 50 Hz, 0.15 mm vertical,
-/// 0.17 degrees torsion; rheonomic runs use the calibrated drift 0.313 rad/s about +z at h = 0.01
-/// s. `nuts` M6 nuts as cylinders (radius 5.25 mm, 5 mm thick, 2.3 g) dropped one by one at `rate`
-/// parts/s (> 0) from at most 14 mm above the cone. With `outlet`: a wiper across the last turn
-/// (6.5 mm above the track: nuts lying flat pass, nuts on edge or on another nut are pushed inwards
-/// off the track onto a return chute that stays 7 mm above the turn below), a straight outlet track
-/// with rails leaving tangentially at the top (azimuth 0, z = 69 mm, along +y) through a cut in the
-/// wall, and an exit plane outside the bowl (tangent to r = 175 mm at azimuth 45 degrees).
-/// `duration` (s); mu = 0.3. Named bowl_feeder_fill above 12 nuts, else bowl_feeder_primitives.
+/// 0.17 degrees torsion; rheonomic runs use the local vibration law at h = 0.01 s
+/// (the calibrated drift 0.313 rad/s about +z, the mesh bowl's, is kept in the scene). `nuts` M6
+/// nuts as cylinders (radius 5.25 mm, 5 mm thick, 2.3 g) dropped one by one at `rate` parts/s (> 0)
+/// from at most 14 mm above the cone. With `outlet`: a wiper across the last turn (6.5 mm above the
+/// track: nuts lying flat pass, nuts on edge or on another nut are pushed inwards off the track
+/// onto a return chute that stays 7 mm above the turn below), a straight outlet track with rails
+/// leaving tangentially at the top (azimuth 0, z = 69 mm, along +y) through a cut in the wall, and
+/// an exit plane outside the bowl (tangent to r = 175 mm at azimuth 45 degrees). `duration` (s); mu
+/// = 0.3. Named bowl_feeder_fill above 12 nuts, else bowl_feeder_primitives.
 Scene bowlFeederScene(int nuts = 12, double rate = 4, bool outlet = true, double duration = 60);
 
 /// A static ring of `count` upright boxes about the world z axis (a turntable's rim): box centres
