@@ -107,7 +107,7 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
       "Screw vibration at 50 Hz: 0.15 mm vertical (1.5 g: the nuts hop) and 0.17 degrees torsion "
       "(0.13 m/s peak at r = 140 mm), as bowl_feeder.json. drift_model local: the rheonomic runs "
       "use the local vibration law, no calibration; against this bowl's own full vibration (ODE, "
-      "friction cone) at 2000 steps per cycle it is within 1 % on the floor and on the ramp "
+      "friction cone) at 2000 steps per cycle it is within 3 % on the floor and 9 % on the ramp "
       "(demos/results/bowl_local_law.md, last section). calibrated_drift: 0.313 rad/s about +z, "
       "bowl_feeder.json's calibration on its ramp, kept for `--drift-model calibrated_drift`; it "
       "is not this bowl's (its runs are 13 % fast on the floor and 2-3x on the ramp).");
