@@ -3,7 +3,7 @@
 # demos/cli/CMakeLists.txt:
 #   cmake -DCMD=<program|arg|arg...> [-DCODE=<exit code, default 0>] [-DOUT_MATCH=<regex>]
 #         [-DERR_MATCH=<regex>] [-DERR_NOT_MATCH=<regex>] [-DLAST_LINE=<regex>]
-#         [-DFILES=<file|file...>] [-DCOPY_TO=<path>] -P cli_test.cmake
+#         [-DFILES=<file|file...>] [-DMAKE_DIRS=<dir|dir...>] [-DCOPY_TO=<path>] -P cli_test.cmake
 # "|" separates the arguments. LAST_LINE must match the last non-empty line of stdout; every
 # file of FILES must exist afterwards (and be removed before). COPY_TO: the program is first
 # copied there (a binary moved away from its share/ folder) and that copy is run.
@@ -20,6 +20,12 @@ endif()
 string(REPLACE "|" ";" files "${FILES}")
 foreach(f IN LISTS files)
   file(REMOVE "${f}")
+endforeach()
+# MAKE_DIRS: folders the command needs to exist (a test must not depend on another test, or on
+# the order ctest runs them in, to have made them).
+string(REPLACE "|" ";" make_dirs "${MAKE_DIRS}")
+foreach(d IN LISTS make_dirs)
+  file(MAKE_DIRECTORY "${d}")
 endforeach()
 set(quoted "")
 foreach(argument IN LISTS command)
