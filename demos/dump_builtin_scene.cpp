@@ -10,21 +10,12 @@
 #include <string>
 
 #include "common/builtin_scenes.hpp"
+#include "rheofeed/output/output.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 
 namespace {
 
 using rheofeed::scene::Scene;
-
-// A JSON string literal of `text` (the comments are ASCII; quotes and backslashes escaped).
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
 
 // Inserts `"comment": text,` as the first member of the object that `anchor` opens (anchor ends
 // with '{') or, when it does not end with '{', on the line after `anchor` (a member line), at
@@ -38,7 +29,8 @@ void insertComment(std::string& json, const std::string& anchor, const std::stri
   std::size_t indent = at - line_start;
   if (anchor.back() == '{') indent += 2;
   const std::size_t line_end = json.find('\n', at);
-  json.insert(line_end + 1, std::string(indent, ' ') + "\"comment\": " + quoted(text) + ",\n");
+  json.insert(line_end + 1, std::string(indent, ' ') +
+                                "\"comment\": " + rheofeed::scene::jsonQuoted(text) + ",\n");
 }
 
 std::string range(int first, int count) {
@@ -50,10 +42,21 @@ std::string range(int first, int count) {
 // order, the floor, 36 cone facets and the apex, the wall's boxes, 2 x 64 ramp boxes, and with the
 // outlet the wiper, the return chute, the outlet track and its two rails.
 void commentBowl(std::string& json, const Scene& scene, bool fill) {
-  const int geoms = static_cast<int>(scene.fixtures.at(0).geoms.size());
+  const auto& g = scene.fixtures.at(0).geoms;
+  const int geoms = static_cast<int>(g.size());
   const int wall = geoms - 1 - 37 - 128 - 5;
-  if (wall <= 0) throw std::logic_error("dump_builtin_scene: the bowl's geoms are not as expected");
   const int ramp_first = 38 + wall, tooling = ramp_first + 128;
+  // The comment's index map must be the builder's: the 128 ramp boxes are one size, unlike the
+  // wall box before them and the wiper after them.
+  const auto size = [&g](int i) { return g[static_cast<std::size_t>(i)].shape.size; };
+  bool layout =
+      wall > 0 && size(ramp_first - 1) != size(ramp_first) && size(tooling) != size(tooling - 1);
+  for (int i = ramp_first + 1; layout && i < tooling; ++i) layout = size(i) == size(ramp_first);
+  if (!layout) {
+    throw std::logic_error(
+        "dump_builtin_scene: the bowl's geoms are no longer floor, 37 cone boxes, the wall, 128 "
+        "ramp boxes and 5 tooling boxes: update commentBowl");
+  }
   if (fill) {
     insertComment(
         json, "{",
