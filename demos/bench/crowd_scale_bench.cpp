@@ -16,13 +16,17 @@
 //
 // Per run: per-step averages of the wall-clock time in collision (dSpaceCollide, dCollide),
 // contact creation and the plugin (surface parameters, FeederSet::driveContacts, joint creation),
-// the solve (dWorldQuickStep) and the scene layer (the rest of the run loop: the part checks,
-// metrics, observers: loop time less the three stages); contact joints and constraint rows per
+// the local vibration law's drift table fill (its point-mass model runs, LocalDriftStats::
+// model_cpu_seconds, run in one thread here: a one-time cost that a saved table, --drift-table,
+// removes, taken out of the contact stage), the solve (dWorldQuickStep) and the scene layer (the
+// rest of the run loop: the part checks, metrics, observers: loop time less the three stages);
+// contact joints and constraint rows per
 // part present; parts lost by kind and sunk (RunHealth); process CPU time, the real-time factor
 // (CPU / simulated time) and the cost's log-log slope d ln(CPU per step) / d ln N between
 // successive part counts. The overall slope spans the second smallest count to the largest
 // (250 -> 2000 in the default trough list: the smallest run is dominated by fixed costs), with
-// the slope of each stage over the same span and the stage whose time per step grew the most.
+// the slope of each stage over the same span and the stage whose time per step grew the most, and
+// the slope without the drift table fill (the cost of a run whose table was saved before).
 //
 // Times are one run each on one machine: compare them as ratios. The stage times are wall-clock
 // (a CPU clock per geom pair would cost more than the stage it measures); the CSV gives them raw
@@ -61,6 +65,7 @@
 #include "rheofeed/simulation/check.hpp"
 #include "rheofeed/simulation/run.hpp"
 #include "rheofeed/simulation/simulation.hpp"
+#include "rheofeed/vibration_drift.hpp"
 
 #ifndef RHEOFEED_SOURCE_DIR
 #error "RHEOFEED_SOURCE_DIR must name the source tree (the bowl scene, demos/results)"
@@ -101,11 +106,18 @@ struct Row {
   double cpuPerStep() const { return metrics.cpu_seconds / steps(); }  // s
   double wallPerStep() const { return wall / steps(); }                // s
   double collision() const { return stages.collision / steps(); }      // s per step
-  double contacts() const { return stages.contacts / steps(); }        // s per step
-  double solve() const { return stages.solve / steps(); }              // s per step
-  double checks() const { return stages.checks / steps(); }            // s per step
-  double sceneLayer() const {                                          // s per step
-    return std::max(0.0, wallPerStep() - collision() - contacts() - solve());
+  // The drift table's fill, a part of the contact stage: its model runs' CPU time as wall-clock
+  // time on this run's share of the core (the table runs them in one thread here: run()).
+  double tableFill() const {  // s per step
+    return metrics.health.local_law.model_cpu_seconds / cpuPerWall() / steps();
+  }
+  double contacts() const {  // s per step, the table fill taken out
+    return std::max(0.0, stages.contacts / steps() - tableFill());
+  }
+  double solve() const { return stages.solve / steps(); }    // s per step
+  double checks() const { return stages.checks / steps(); }  // s per step
+  double sceneLayer() const {                                // s per step
+    return std::max(0.0, wallPerStep() - collision() - stages.contacts / steps() - solve());
   }
   double contactsPerPart() const {
     return mean_parts > 0 ? double(stages.contact_count) / steps() / mean_parts : 0;
@@ -115,6 +127,10 @@ struct Row {
   }
   // CPU time over wall-clock time of the run loop: 1 on an idle core.
   double cpuPerWall() const { return wall > 0 ? metrics.cpu_seconds / wall : 1; }
+  // CPU time per step less the drift table fill: a run with a saved table (s).
+  double cpuPerStepSavedTable() const {
+    return cpuPerStep() - metrics.health.local_law.model_cpu_seconds / steps();
+  }
 };
 
 // The stages of a row in the order of the tables and the plot: name, wall-clock seconds per step.
@@ -123,13 +139,14 @@ struct Stage {
   double (Row::*perStep)() const;
 };
 // A stage's CPU seconds per step, estimated as its share of the loop's wall-clock time times the
-// CPU time per step (other work on the core slows every stage alike): the four stages of a row
-// then add up to its CPU time per step.
+// CPU time per step (other work on the core slows every stage alike): the stages of a row then
+// add up to its CPU time per step.
 double cpuPerStep(const Row& r, const Stage& s) {
   return (r.*s.perStep)() * r.cpuPerWall();
 }
 const Stage kStages[] = {{"collision", &Row::collision},
                          {"contact creation and the plugin", &Row::contacts},
+                         {"drift table fill", &Row::tableFill},
                          {"solve", &Row::solve},
                          {"scene layer", &Row::sceneLayer}};
 
@@ -193,7 +210,7 @@ const char* kCsvHeader =
     "contacts_ms_per_step,solve_ms_per_step,scene_layer_ms_per_step,checks_ms_per_step,"
     "contacts_per_part,rows_per_part,lost,lost_through_fixture,lost_fell,lost_inside_fixture,"
     "lost_left_feeder,lost_other,sunk,exited,local_law_cells,local_law_model_runs,"
-    "scene_check_warnings,cpu_slope_from_previous\n";
+    "local_law_model_cpu_s,scene_check_warnings,cpu_slope_from_previous\n";
 
 std::string csvRow(const Row& r, const Row* previous) {
   const RunHealth& h = r.metrics.health;
@@ -212,7 +229,7 @@ std::string csvRow(const Row& r, const Row* previous) {
        << h.parts_inside_fixture << ',' << h.parts_left_feeder << ','
        << h.parts_out_of_bounds + h.parts_nonfinite + h.parts_too_fast << ',' << h.parts_sunk << ','
        << h.parts_exited << ',' << h.local_law.cells_computed << ',' << h.local_law.model_runs
-       << ',' << r.check_warnings << ',';
+       << ',' << formatNumber(h.local_law.model_cpu_seconds, 4) << ',' << r.check_warnings << ',';
   if (previous) {
     line << formatNumber(slope(previous->parts, previous->cpuPerStep(), r.parts, r.cpuPerStep()),
                          3);
@@ -243,9 +260,9 @@ std::string markdownTables(const std::vector<const Row*>& rows, const std::strin
   const auto ms = [](double s) { return formatNumber(1e3 * s, 3); };
   md << "## " << title << "\n\n"
      << "| parts | CPU (s) | real-time factor | CPU ms/step | collision | contacts + plugin | "
-        "solve | scene layer | contacts/part | rows/part | lost (through, fell, inside) | "
-        "sunk | point-mass runs | slope |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|"
-        "---|\n";
+        "drift table fill | solve | scene layer | contacts/part | rows/part | lost (through, "
+        "fell, inside) | sunk | point-mass runs | slope |\n|---|---|---|---|---|---|---|---|---|"
+        "---|---|---|---|---|---|\n";
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const Row& r = *rows[k];
     const RunHealth& h = r.metrics.health;
@@ -253,10 +270,10 @@ std::string markdownTables(const std::vector<const Row*>& rows, const std::strin
        << formatNumber(r.metrics.real_time_factor, 3) << " | " << ms(r.cpuPerStep()) << " | "
        << ms(cpuPerStep(r, kStages[0])) << " | " << ms(cpuPerStep(r, kStages[1])) << " | "
        << ms(cpuPerStep(r, kStages[2])) << " | " << ms(cpuPerStep(r, kStages[3])) << " | "
-       << formatNumber(r.contactsPerPart(), 3) << " | " << formatNumber(r.rowsPerPart(), 3) << " | "
-       << h.partsLost() << " (" << h.parts_through_fixture << ", " << h.parts_fell << ", "
-       << h.parts_inside_fixture << ") | " << h.parts_sunk << " | " << h.local_law.model_runs
-       << " | "
+       << ms(cpuPerStep(r, kStages[4])) << " | " << formatNumber(r.contactsPerPart(), 3) << " | "
+       << formatNumber(r.rowsPerPart(), 3) << " | " << h.partsLost() << " ("
+       << h.parts_through_fixture << ", " << h.parts_fell << ", " << h.parts_inside_fixture
+       << ") | " << h.parts_sunk << " | " << h.local_law.model_runs << " | "
        << (k ? formatNumber(
                    slope(rows[k - 1]->parts, rows[k - 1]->cpuPerStep(), r.parts, r.cpuPerStep()), 3)
              : std::string("-"))
@@ -269,7 +286,11 @@ std::string markdownTables(const std::vector<const Row*>& rows, const std::strin
     md << "Overall " << a.parts << " -> " << b.parts << " parts: CPU per step grows as N^"
        << formatNumber(slope(a.parts, a.cpuPerStep(), b.parts, b.cpuPerStep()), 3)
        << " (wall-clock per step N^"
-       << formatNumber(slope(a.parts, a.wallPerStep(), b.parts, b.wallPerStep()), 3) << ").";
+       << formatNumber(slope(a.parts, a.wallPerStep(), b.parts, b.wallPerStep()), 3)
+       << "); without the drift table fill (a run with a saved table) N^"
+       << formatNumber(slope(a.parts, a.cpuPerStepSavedTable(), b.parts, b.cpuPerStepSavedTable()),
+                       3)
+       << ".";
     const Stage* top = nullptr;
     double top_growth = -1, total_growth = 0;
     for (const Stage& s : kStages) total_growth += cpuPerStep(b, s) - cpuPerStep(a, s);
@@ -317,15 +338,19 @@ std::string troughGoals(const std::vector<const Row*>& rows) {
   std::ostringstream md;
   const char* bullet = "- ";
   if (const Row* a = at(250), *b = at(2000); a && b) {
-    const double s = slope(a->parts, a->cpuPerStep(), b->parts, b->cpuPerStep());
-    md << bullet << "cost per step N^1.1 or slower from 250 to 2000 parts: N^" << formatNumber(s, 3)
-       << (s <= 1.1 ? " (met)"
-                    : " (missed: " +
-                          formatNumber(b->cpuPerStep() / a->cpuPerStep() /
-                                           std::pow(double(b->parts) / a->parts, 1.1),
-                                       3) +
-                          " x the cost per step at 2000 that N^1.1 allows)")
-       << "\n";
+    // The whole run's cost, and the cost with a saved drift table (no fill).
+    for (const bool saved : {false, true}) {
+      const double ca = saved ? a->cpuPerStepSavedTable() : a->cpuPerStep();
+      const double cb = saved ? b->cpuPerStepSavedTable() : b->cpuPerStep();
+      const double s = slope(a->parts, ca, b->parts, cb);
+      md << bullet << "cost per step N^1.1 or slower from 250 to 2000 parts"
+         << (saved ? ", the drift table fill left out" : "") << ": N^" << formatNumber(s, 3)
+         << (s <= 1.1 ? " (met)"
+                      : " (missed: " +
+                            formatNumber(cb / ca / std::pow(double(b->parts) / a->parts, 1.1), 3) +
+                            " x the cost per step at 2000 that N^1.1 allows)")
+         << "\n";
+    }
   }
   for (const auto& [parts, goal] : {std::pair{500, 0.1}, std::pair{2000, 0.5}}) {
     if (const Row* r = at(parts)) {
@@ -352,18 +377,20 @@ std::string plotScript(const std::vector<std::pair<std::string, std::vector<cons
      << "set multiplot layout 1," << scenes.size()
      << " title 'ODE + plugin, h = " << formatNumber(dt)
      << " s: time per step by stage (log-log)'\n";
-  // CSV columns: 1 scene, 2 parts, 10 cpu_per_wall, 12 cpu_ms_per_step, 14 collision,
-  // 15 contacts, 16 solve, 17 scene layer (wall-clock: scaled by cpu_per_wall, as the tables).
-  const std::pair<int, const char*> series[] = {{12, "CPU total"},
-                                                {14, "collision"},
-                                                {15, "contacts + plugin"},
-                                                {16, "solve"},
-                                                {17, "scene layer"}};
+  // CSV columns: 1 scene, 2 parts, 5 steps, 10 cpu_per_wall, 12 cpu_ms_per_step, 14 collision,
+  // 15 contacts (with the table fill), 16 solve, 17 scene layer (wall-clock: scaled by
+  // cpu_per_wall, as the tables), 31 the table fill's CPU seconds (taken out of the contacts).
+  const std::pair<std::string, const char*> series[] = {
+      {"$12", "CPU total"},
+      {"$14 * $10", "collision"},
+      {"($15 * $10 - 1e3 * $31 / $5)", "contacts + plugin"},
+      {"(1e3 * $31 / $5)", "drift table fill"},
+      {"$16 * $10", "solve"},
+      {"$17 * $10", "scene layer"}};
   for (const auto& [scene, rows] : scenes) {
     gp << "set title '" << scene << "'\nplot ";
     const char* comma = "";
-    for (const auto& [column, title] : series) {
-      const std::string y = column == 12 ? "$12" : "$" + std::to_string(column) + " * $10";
+    for (const auto& [y, title] : series) {
       gp << comma << "$data using (strcol(1) eq '" << scene << "' ? $2 : 1/0):((" << y << " > 0) ? "
          << y << " : 1/0) with linespoints lw 2 pt 7 title '" << title << "'";
       comma = ", ";
@@ -424,6 +451,9 @@ int run(const Options& o) {
                                   formatNumber(o.dt) + " s: " + e.what());
     }
   }
+  // The drift table's model runs in the runs' own thread, so that their time is one core's, as
+  // the rest of the step (the default uses every hardware thread).
+  rheofeed::LocalDriftTable::shared()->setThreads(1);
   std::vector<Row> rows;
   for (std::size_t k = 0; k < jobs.size(); ++k) {
     std::fprintf(stderr, "crowd_scale: run %zu of %zu: %s, %d parts, %g s at h = %g s\n", k + 1,
@@ -471,7 +501,10 @@ int run(const Options& o) {
         "time times the CPU time per step (they add up to the CPU column; crowd_scale.csv has "
         "the raw wall-clock times and CPU / wall per run). Collision: dSpaceCollide and "
         "dCollide; contact creation and the plugin: surface parameters, "
-        "FeederSet::driveContacts (the vibration law), joint creation; solve: dWorldQuickStep; "
+        "FeederSet::driveContacts (the vibration law), joint creation; drift table fill: the local "
+        "law's point-mass model runs (in one thread; the runs share one table in increasing "
+        "part counts, so a later run fills only what earlier ones did not; a saved table "
+        "removes it); solve: dWorldQuickStep; "
         "scene layer: the rest of the loop (part checks, metrics, observers). Contacts and "
         "rows per part: contact joints and constraint rows per step over the parts present "
         "(spawned, not exited), averaged over the run. Lost: RunHealth::partsLost, every kind "

@@ -20,7 +20,8 @@ set(columns
   real_time_factor cpu_ms_per_step wall_ms_per_step collision_ms_per_step contacts_ms_per_step
   solve_ms_per_step scene_layer_ms_per_step checks_ms_per_step contacts_per_part rows_per_part
   lost lost_through_fixture lost_fell lost_inside_fixture lost_left_feeder lost_other sunk exited
-  local_law_cells local_law_model_runs scene_check_warnings cpu_slope_from_previous)
+  local_law_cells local_law_model_runs local_law_model_cpu_s scene_check_warnings
+  cpu_slope_from_previous)
 list(LENGTH columns width)
 file(STRINGS "${OUT}/crowd_scale.csv" lines)
 list(LENGTH lines count)

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "rheofeed/vibration_drift.hpp"
 
+#include <time.h>
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -267,6 +268,13 @@ struct Cell {
   std::uint32_t filled = 0;  // bit c: corners[c] computed
 };
 
+// CPU time of the calling thread (s): the model runs' cost, counted by the threads that run them.
+double threadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 }  // namespace
 
 struct LocalDriftTable::Impl {
@@ -310,7 +318,9 @@ struct LocalDriftTable::Impl {
     std::atomic<std::size_t> next{0};
     std::exception_ptr failure;
     std::mutex failure_mutex;
+    double cpu = 0;  // summed over the threads (under failure_mutex)
     auto work = [&] {
+      const double cpu_start = threadCpuSeconds();
       for (std::size_t k = next++; k < missing.size(); k = next++) {
         try {
           results[k] = pointMassDrift(cornerParams(missing[k], mu), settings);
@@ -319,6 +329,8 @@ struct LocalDriftTable::Impl {
           if (!failure) failure = std::current_exception();
         }
       }
+      const std::lock_guard<std::mutex> lock(failure_mutex);
+      cpu += threadCpuSeconds() - cpu_start;
     };
     const std::size_t helpers =
         std::min(missing.size(), static_cast<std::size_t>(std::max(threads, 1))) - 1;
@@ -332,6 +344,7 @@ struct LocalDriftTable::Impl {
       corners.emplace(missing[k], Corner{results[k].along, results[k].across, results[k].valid});
     }
     stats.model_runs += static_cast<std::int64_t>(missing.size());
+    stats.model_cpu_seconds += cpu;
   }
 };
 
@@ -512,8 +525,10 @@ PointMassDrift LocalDriftTable::drift(const PointMassParams& p) {
       result.across = v2;
       result.valid = true;
     } else {  // a corner beyond the friction angle: the point itself may still be inside
+      const double cpu_start = threadCpuSeconds();
       result = pointMassDrift(p, s.settings);
       ++s.stats.model_runs;
+      s.stats.model_cpu_seconds += threadCpuSeconds() - cpu_start;
     }
   }
   s.has_last = true;

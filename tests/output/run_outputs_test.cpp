@@ -79,6 +79,7 @@ RunMetrics run() {
   h.local_law.wall_contacts = 5;
   h.local_law.cells_computed = 6;
   h.local_law.model_runs = 7;
+  h.local_law.model_cpu_seconds = 0.25;
   h.local_law_corners_at_start = 8;
   r.scene_check = {"tunnelling: step \\ 2\nsafe"};
   r.feeder.note = "the scene has no exit plane";
@@ -178,8 +179,9 @@ TEST(SummaryJson, ParsesToTheRunMetricsWritten) {
   EXPECT_EQ(l["wall_contacts"], 5);
   EXPECT_EQ(l["cells_computed"], 6);
   EXPECT_EQ(l["model_runs"], 7);
+  EXPECT_EQ(l["model_cpu_s"], 0.25);
   EXPECT_EQ(l["corners_at_start"], 8);
-  EXPECT_EQ(l.size(), 6u);  // feeders, contacts, wall_contacts, cells, model runs, corners
+  EXPECT_EQ(l.size(), 7u);  // feeders, contacts, wall_contacts, cells, model runs and CPU, corners
 }
 
 TEST(SummaryJson, AngularRunsSayRadiansPerSecond) {

@@ -275,9 +275,11 @@ TEST(LocalDriftTable, InterpolatesTheExactModel) {
   p.mu = 0.5;
   table.drift(p);
   const std::int64_t runs = table.stats().model_runs;
+  const double model_cpu = table.stats().model_cpu_seconds;
   p.normal_throw = 0.62;  // same cell
   table.drift(p);
   EXPECT_EQ(table.stats().model_runs, runs);
+  EXPECT_EQ(table.stats().model_cpu_seconds, model_cpu);  // no model run, no model time
 }
 
 // A query on grid lines runs only the corners its interpolation weights: a level floor
@@ -346,6 +348,7 @@ TEST(LocalDriftTable, CornersCarriedIntoAnotherTableGiveTheSameDriftsWithoutMode
     EXPECT_EQ(a.across, b.across) << "point " << i;
   }
   EXPECT_EQ(second.stats().model_runs, 0);
+  EXPECT_EQ(second.stats().model_cpu_seconds, 0);
   EXPECT_EQ(second.addCorners(corners), 0u);  // all known
 
   std::vector<DriftTableCorner> bad = {corners[0], corners[1]};

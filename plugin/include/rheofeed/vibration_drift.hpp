@@ -154,6 +154,8 @@ struct LocalDriftStats {
   std::int64_t model_runs = 0;      ///< pointMassDrift calls (grid corners)
   std::int64_t corners_added = 0;   ///< grid corners taken from elsewhere (addCorners: a saved
                                     ///< table), not run here
+  double model_cpu_seconds = 0;     ///< CPU time of those model runs (s, summed over the threads
+                                    ///< that ran them): what a saved table saves
 };
 
 /// One grid corner of a LocalDriftTable: the point-mass drift (V1, V2) = (along, across), units

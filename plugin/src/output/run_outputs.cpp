@@ -76,10 +76,11 @@ std::string summaryJson(const RunMetrics& r) {
   char d[384];
   std::snprintf(d, sizeof d,
                 "{\"feeders\": %d, \"contacts\": %lld, \"wall_contacts\": %lld, "
-                "\"cells_computed\": %lld, \"model_runs\": %lld, \"corners_at_start\": %lld}",
+                "\"cells_computed\": %lld, \"model_runs\": %lld, \"model_cpu_s\": %.6g, "
+                "\"corners_at_start\": %lld}",
                 h.local_law_feeders, static_cast<long long>(l.contacts),
                 static_cast<long long>(l.wall_contacts), static_cast<long long>(l.cells_computed),
-                static_cast<long long>(l.model_runs),
+                static_cast<long long>(l.model_runs), l.model_cpu_seconds,
                 static_cast<long long>(h.local_law_corners_at_start));
   return json + "], \"feeder\": " + feederJson(r.feeder) + ", \"local_law\": " + d + "}";
 }

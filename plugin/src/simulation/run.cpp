@@ -61,11 +61,11 @@ void HealthReport::onEnd(const Simulation& sim) {
     std::fprintf(stderr,
                  "rheofeed: %s, %s: local vibration law on %d feeder(s): %lld contacts driven "
                  "(%lld on walls or steep faces), %lld drift table cells, %lld point-mass runs "
-                 "(%lld table corners known at the start)\n",
+                 "(%.3g s of CPU; %lld table corners known at the start)\n",
                  scene_name_.c_str(), toString(sim.method()), h.local_law_feeders,
                  static_cast<long long>(l.contacts), static_cast<long long>(l.wall_contacts),
                  static_cast<long long>(l.cells_computed), static_cast<long long>(l.model_runs),
-                 static_cast<long long>(h.local_law_corners_at_start));
+                 l.model_cpu_seconds, static_cast<long long>(h.local_law_corners_at_start));
   }
 }
 

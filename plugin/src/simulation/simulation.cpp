@@ -592,6 +592,7 @@ void PartSimulation::step() {
       sum.wall_contacts += s.wall_contacts - start.wall_contacts;
       sum.cells_computed += s.cells_computed - start.cells_computed;
       sum.model_runs += s.model_runs - start.model_runs;
+      sum.model_cpu_seconds += s.model_cpu_seconds - start.model_cpu_seconds;
       sum.corners_added += s.corners_added - start.corners_added;
     }
     health_.local_law = sum;

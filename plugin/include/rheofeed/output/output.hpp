@@ -57,7 +57,7 @@ std::string seriesCsv(const RunMetrics& run);
 /// RunHealth, parts_lost, the share of Coulomb fallback steps, the maximum part speed and its
 /// bound, and the list of ignored settings; the scene check's warnings; a "feeder" object
 /// (feederJson); and a "local_law" object (RunHealth::local_law: feeders, contacts,
-/// wall_contacts, cells_computed, model_runs; corners_at_start from
+/// wall_contacts, cells_computed, model_runs, model_cpu_s (s); corners_at_start from
 /// RunHealth::local_law_corners_at_start).
 std::string summaryJson(const RunMetrics& run);
 
