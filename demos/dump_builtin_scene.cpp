@@ -17,6 +17,9 @@ namespace {
 
 using rheofeed::scene::Scene;
 
+// The local law's point-mass results of the shipped scenes, relative to demos/scenes/.
+constexpr const char* kDriftTable = "tables/drift_table.json";
+
 // Inserts `"comment": text,` as the first member of the object that `anchor` opens (anchor ends
 // with '{') or, when it does not end with '{', on the line after `anchor` (a member line), at
 // that line's indentation.
@@ -68,8 +71,10 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
         "into the bowl over a return chute, and leave lying flat through a tangential outlet. The "
         "rheonomic runs use the local vibration law (no calibration). Outputs: output rate and "
         "cumulative count at the exit plane, first part out, exit "
-        "orientation, mean height against time, angular drift. Numbers and commands: "
-        "demos/results/bowl_feeder.md.");
+        "orientation, mean height against time, angular drift. drift_table: the local law's "
+        "point-mass results of the shipped scenes (tables/drift_table.json, written by `rheofeed "
+        "run SCENE --drift-table demos/scenes/tables/drift_table.json`), so that a first run "
+        "skips those model runs. Numbers and commands: demos/results/bowl_feeder.md.");
   } else {
     insertComment(
         json, "{",
@@ -77,8 +82,11 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
         "bowl_feeder_primitives`; written by dump_builtin_scene from builtin_scenes.hpp "
         "bowlFeederScene()): the same bowl, tooling and outlet as bowl_feeder_fill. Rheonomic at "
         "h = 0.01 s (the paper's step) on the local vibration law, with no nut lost or sunk in 60 "
-        "s, where the mesh bowl of bowl_feeder.json loses 5 of 12 in 12 s at that step. Numbers "
-        "and commands: demos/results/bowl_feeder.md.");
+        "s, where the mesh bowl of bowl_feeder.json loses 5 of 12 in 12 s at that step. "
+        "drift_table: the local law's point-mass results of the shipped scenes "
+        "(tables/drift_table.json, written by `rheofeed run SCENE --drift-table "
+        "demos/scenes/tables/drift_table.json`), so that a first run skips those model runs. "
+        "Numbers and commands: demos/results/bowl_feeder.md.");
   }
   insertComment(
       json, "\"name\": \"bowl\",",
@@ -146,7 +154,9 @@ int main(int argc, char** argv) {
   using namespace rheofeed::scene;
   try {
     const bool fill = name == "bowl_feeder_fill";
-    const Scene scene = fill ? bowlFeederScene(240, 6, true, 300) : bowlFeederScene();
+    Scene scene = fill ? bowlFeederScene(240, 6, true, 300) : bowlFeederScene();
+    // The shipped scenes' drift table (demos/scenes/tables/): a first run skips its model runs.
+    scene.drift_table = kDriftTable;
     std::string json = toJson(scene);
     commentBowl(json, scene, fill);
     std::cout << json;

@@ -188,14 +188,16 @@ Json sceneNumber(double v) {
   return Json(r);
 }
 
-// Mesh file names of the base scene made absolute (relative to the base scene's folder), so
-// that a generated scene works from its own folder.
-void absoluteMeshes(Json& scene, const fs::path& folder) {
-  auto fix = [&](Json& o) {
-    if (!o.is_object() || !o.contains("mesh") || !o["mesh"].is_string()) return;
-    const fs::path m(o["mesh"].get<std::string>());
-    if (!m.empty() && m.is_relative()) o["mesh"] = (folder / m).lexically_normal().string();
+// File names of the base scene (its meshes and its drift table) made absolute (relative to the
+// base scene's folder), so that a generated scene works from its own folder.
+void absoluteFileNames(Json& scene, const fs::path& folder) {
+  auto fixKey = [&](Json& o, const char* key) {
+    if (!o.is_object() || !o.contains(key) || !o[key].is_string()) return;
+    const fs::path m(o[key].get<std::string>());
+    if (!m.empty() && m.is_relative()) o[key] = (folder / m).lexically_normal().string();
   };
+  auto fix = [&](Json& o) { fixKey(o, "mesh"); };
+  fixKey(scene, "drift_table");
   if (scene.contains("fixtures") && scene["fixtures"].is_array()) {
     for (Json& f : scene["fixtures"]) {
       if (f.is_object() && f.contains("geoms") && f["geoms"].is_array()) {
@@ -409,7 +411,7 @@ Spec loadSpec(const fs::path& file) {
   } catch (const std::exception& e) {
     fail(file, "scene", e.what());
   }
-  absoluteMeshes(base, spec.scene_file.parent_path());
+  absoluteFileNames(base, spec.scene_file.parent_path());
 
   // Methods.
   spec.methods = {"ode_rheonomic"};

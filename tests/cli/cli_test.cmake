@@ -3,10 +3,13 @@
 # demos/cli/CMakeLists.txt:
 #   cmake -DCMD=<program|arg|arg...> [-DCODE=<exit code, default 0>] [-DOUT_MATCH=<regex>]
 #         [-DERR_MATCH=<regex>] [-DERR_NOT_MATCH=<regex>] [-DLAST_LINE=<regex>]
-#         [-DFILES=<file|file...>] [-DMAKE_DIRS=<dir|dir...>] [-DCOPY_TO=<path>] -P cli_test.cmake
+#         [-DFILES=<file|file...>] [-DMAKE_DIRS=<dir|dir...>] [-DCOPY_TO=<path>]
+#         [-DSCENE_FROM=<scene file> -DSCENE_TO=<path> [-DSCENE_DRIFT_TABLE=<name>]] -P cli_test.cmake
 # "|" separates the arguments. LAST_LINE must match the last non-empty line of stdout; every
 # file of FILES must exist afterwards (and be removed before). COPY_TO: the program is first
-# copied there (a binary moved away from its share/ folder) and that copy is run.
+# copied there (a binary moved away from its share/ folder) and that copy is run. SCENE_FROM and
+# SCENE_TO: the scene file is first written to SCENE_TO with its top-level "drift_table" set to
+# SCENE_DRIFT_TABLE, or removed when that is empty or not given.
 string(REPLACE "|" ";" command "${CMD}")
 if(COPY_TO)
   list(GET command 0 program)
@@ -27,6 +30,21 @@ string(REPLACE "|" ";" make_dirs "${MAKE_DIRS}")
 foreach(d IN LISTS make_dirs)
   file(MAKE_DIRECTORY "${d}")
 endforeach()
+if(SCENE_FROM)
+  file(READ "${SCENE_FROM}" scene)
+  if(NOT scene MATCHES "\n  \"drift_table\": \"[^\"]*\",")
+    message(FATAL_ERROR "${SCENE_FROM} has no top-level \"drift_table\" member to replace")
+  endif()
+  if(SCENE_DRIFT_TABLE)
+    string(REGEX REPLACE "\n  \"drift_table\": \"[^\"]*\","
+           "\n  \"drift_table\": \"${SCENE_DRIFT_TABLE}\"," scene "${scene}")
+  else()
+    string(REGEX REPLACE "\n  \"drift_table\": \"[^\"]*\"," "" scene "${scene}")
+  endif()
+  get_filename_component(folder "${SCENE_TO}" DIRECTORY)
+  file(MAKE_DIRECTORY "${folder}")
+  file(WRITE "${SCENE_TO}" "${scene}")
+endif()
 set(quoted "")
 foreach(argument IN LISTS command)
   string(APPEND quoted " [==[${argument}]==]")

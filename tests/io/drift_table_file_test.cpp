@@ -122,5 +122,65 @@ TEST(DriftTableFile, RefusesFilesOfOtherSettingsOrMalformed) {
   EXPECT_NE(loadError(fs::temp_directory_path(), table).find("directory"), std::string::npos);
 }
 
+// A scene file's "drift_table" names a table relative to the scene's folder: loading the scene
+// reads its corners (exactly the file's), makes the name absolute so that the scene written
+// elsewhere still finds it, and writes it back; an empty name, a missing or a malformed table is
+// an error naming the scene, the key and the table's own problem.
+TEST(DriftTableFile, SceneFileNamesItsTableRelativeToItsFolder) {
+  const fs::path folder = fs::temp_directory_path() / "rheofeed_scene_drift_table";
+  fs::remove_all(folder);
+  fs::create_directories(folder / "tables");
+  // The process's table settings: a scene's table adds to LocalDriftTable::shared().
+  LocalDriftTable filled(LocalDriftTable::shared()->settings());
+  PointMassParams p;
+  p.normal_throw = 1.2;
+  p.tangential_throw = 2.0;
+  p.mu = 0.4;
+  filled.drift(p);  // one cell on the level: its 4 corners
+  ASSERT_GT(filled.numCorners(), 0u);
+  std::ofstream(folder / "tables" / "t.json", std::ios::binary) << driftTableJson(filled);
+  const std::string base = R"({"drift_table": "NAME",
+    "fixtures": [{"geoms": [{"shape": "box", "size": [1, 0.1, 0.02]}],
+                  "law": {"vibration": {"amplitude": 2e-4, "frequency": 50}}}],
+    "parts": [{"shape": "box", "size": [0.02, 0.02, 0.005],
+               "spawn_min": [0, 0, 0.02], "spawn_max": [0, 0, 0.02]}]})";
+  auto write = [&](const std::string& name) {
+    std::string text = base;
+    text.replace(text.find("NAME"), 4, name);
+    const fs::path file = folder / "scene.json";
+    std::ofstream(file, std::ios::binary) << text;
+    return file;
+  };
+  const Scene scene = loadScene(write("tables/t.json"));
+  ASSERT_NE(scene.drift_table_corners, nullptr);
+  ASSERT_EQ(scene.drift_table_corners->size(), filled.numCorners());
+  const std::vector<DriftTableCorner> expected = filled.corners();
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ((*scene.drift_table_corners)[k].along, expected[k].along) << k;
+    EXPECT_EQ((*scene.drift_table_corners)[k].across, expected[k].across) << k;
+  }
+  EXPECT_EQ(fs::path(scene.drift_table), fs::absolute(folder / "tables" / "t.json"));
+  EXPECT_NE(toJson(scene).find("\"drift_table\": \"" + scene.drift_table + "\""),
+            std::string::npos);
+
+  std::ofstream(folder / "tables" / "bad.json", std::ios::binary) << "{\"format\": 1}";
+  const std::pair<const char*, const char*> refused[] = {
+      {"", "empty file name"},
+      {"tables/none.json", "file not found"},
+      {"tables/bad.json", "not a drift table file"}};
+  for (const auto& [name, problem] : refused) {
+    SCOPED_TRACE(name);
+    try {
+      loadScene(write(name));
+      ADD_FAILURE() << "no error";
+    } catch (const SceneFileError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("scene.json: drift_table: "), std::string::npos) << message;
+      EXPECT_NE(message.find(problem), std::string::npos) << message;
+    }
+  }
+  fs::remove_all(folder);
+}
+
 }  // namespace
 }  // namespace rheofeed::scene

@@ -536,7 +536,9 @@ MotionLaw rheonomicLaw(const Scene& scene, int fixture) {
         case DriftModel::Local: {
           const LocalVibration v = localVibration(law.vibration, scene.gravity, scene.material.mu);
           v.validate(where + ".law.vibration");
-          return MotionLaw::localVibration(v, LocalDriftTable::shared());
+          const std::shared_ptr<LocalDriftTable> table = LocalDriftTable::shared();
+          if (scene.drift_table_corners) table->addCorners(*scene.drift_table_corners);
+          return MotionLaw::localVibration(v, table);
         }
       }
   }

@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "rheofeed/scene/drift_table_file.hpp"
 #include "rheofeed/scene/mesh.hpp"
 #include "scene_io_internal.hpp"
 #include "scene_limits.hpp"
@@ -609,6 +610,9 @@ Scene readScene(const json& root) {
   o.opt("duration", s.duration, Range::Positive);
   o.opt("removal_height", s.removal_height);
   o.opt("seed", s.seed);
+  if (o.opt("drift_table", s.drift_table) && s.drift_table.empty()) {
+    fail(o.at("drift_table"), "empty file name");
+  }
   if (const json* v = o.find("outputs")) {
     Object m(*v, "outputs");
     Outputs& x = s.outputs;
@@ -645,6 +649,26 @@ Scene readScene(const json& root) {
   fail(path, rest);
 }
 
+// Reads the corners of scene.drift_table (relative to `base_dir`) with the shared table's
+// settings and makes the name absolute (as the meshes', so that the scene written elsewhere, by
+// a sweep or a calibration, still finds it); a refusal names "drift_table" and the table file's
+// own error.
+void loadSceneDriftTable(Scene& scene, const fs::path& base_dir) {
+  fs::path file(scene.drift_table);
+  if (file.is_relative()) file = base_dir / file;
+  LocalDriftTable table(LocalDriftTable::shared()->settings());
+  try {
+    loadDriftTable(file, table);
+  } catch (const SceneFileError& e) {
+    fail("drift_table", std::string(e.what()) +
+                            " (the table only saves the local law's point-mass model runs: remove "
+                            "\"drift_table\" from the scene file to run without it)");
+  }
+  scene.drift_table = fs::absolute(file).lexically_normal().string();
+  scene.drift_table_corners =
+      std::make_shared<const std::vector<DriftTableCorner>>(table.corners());
+}
+
 }  // namespace
 
 Scene parseScene(const std::string& json_text, const std::string& source_name,
@@ -657,6 +681,9 @@ Scene parseScene(const std::string& json_text, const std::string& source_name,
       rethrowWithPath(e);
     }
     if (scene.hasMeshes()) loadSceneMeshes(scene, fs::path(source_name).parent_path(), mesh_loader);
+    if (!scene.drift_table.empty()) {
+      loadSceneDriftTable(scene, fs::path(source_name).parent_path());
+    }
     try {
       (void)drawParts(scene);  // refuses spawn regions too small for the parts
     } catch (const std::invalid_argument& e) {

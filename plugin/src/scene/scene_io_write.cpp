@@ -169,6 +169,7 @@ std::string toJson(const Scene& scene) {
   out["duration"] = scene.duration;
   out["removal_height"] = scene.removal_height;
   out["seed"] = scene.seed;
+  if (!scene.drift_table.empty()) out["drift_table"] = scene.drift_table;
   ojson fixtures = ojson::array();
   for (const Fixture& f : scene.fixtures) {
     ojson fj{{"name", f.name}};

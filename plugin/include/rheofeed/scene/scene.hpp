@@ -291,6 +291,17 @@ struct Scene {
   double duration = 1.0;
   std::uint64_t seed = 1;
   Outputs outputs;
+  /// A drift table file (scene/drift_table_file.hpp: the local vibration law's point-mass
+  /// results), its name relative to the scene file's folder; empty: none. Read when the scene is
+  /// loaded from a file, when the name becomes absolute (a missing or bad file is an error naming
+  /// "drift_table", the file and its problem); every
+  /// rheonomic run of a feeder on the local law adds its corners to the process's table
+  /// (LocalDriftTable::shared), so that even a scene's first run skips those model runs, with the
+  /// same drifts bit for bit. Corners the file lacks are computed as without it. Written by
+  /// `rheofeed run SCENE --drift-table FILE`; the shipped local-law scenes name theirs.
+  std::string drift_table;
+  /// The corners read from drift_table (null until the scene is loaded from a file).
+  std::shared_ptr<const std::vector<DriftTableCorner>> drift_table_corners;
 
   /// Throws std::invalid_argument naming the path of the first bad value, the value and the
   /// allowed range (e.g. "parts[0].density = 1e+300: must be a finite number in [0.001, 1e+06]
