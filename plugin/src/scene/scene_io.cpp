@@ -652,10 +652,18 @@ Scene readScene(const json& root) {
 // Reads the corners of scene.drift_table (relative to `base_dir`) with the shared table's
 // settings and makes the name absolute (as the meshes', so that the scene written elsewhere, by
 // a sweep or a calibration, still finds it); a refusal names "drift_table" and the table file's
-// own error.
+// own error. A file that is not there is noted in scene.drift_table_problem instead (Scene).
 void loadSceneDriftTable(Scene& scene, const fs::path& base_dir) {
   fs::path file(scene.drift_table);
   if (file.is_relative()) file = base_dir / file;
+  std::error_code ec;
+  if (!fs::exists(file, ec) && !fs::is_symlink(file, ec)) {  // a scene copied without its table
+    scene.drift_table_problem =
+        "drift_table " + file.string() +
+        ": file not found, not read (the local law's point-mass model runs fill the table, as "
+        "without it; copy the table there, or remove \"drift_table\" from the scene file)";
+    return;
+  }
   LocalDriftTable table(LocalDriftTable::shared()->settings());
   try {
     loadDriftTable(file, table);

@@ -362,6 +362,7 @@ MotionLaw PartSimulation::feederLaw(int fixture) {
     if (!known) {
       local_tables_.emplace_back(table, table->stats());
       health_.local_law_corners_at_start += static_cast<std::int64_t>(table->numCorners());
+      if (!scene_.drift_table_problem.empty()) ignoreSetting(scene_.drift_table_problem);
     }
   }
   return law;

@@ -293,13 +293,17 @@ struct Scene {
   Outputs outputs;
   /// A drift table file (scene/drift_table_file.hpp: the local vibration law's point-mass
   /// results), its name relative to the scene file's folder; empty: none. Read when the scene is
-  /// loaded from a file, when the name becomes absolute (a missing or bad file is an error naming
-  /// "drift_table", the file and its problem); every
-  /// rheonomic run of a feeder on the local law adds its corners to the process's table
-  /// (LocalDriftTable::shared), so that even a scene's first run skips those model runs, with the
-  /// same drifts bit for bit. Corners the file lacks are computed as without it. Written by
+  /// loaded from a file, when the name becomes absolute; every rheonomic run of a feeder on the
+  /// local law adds its corners to the process's table (LocalDriftTable::shared), so that even a
+  /// scene's first run skips those model runs, with the same drifts bit for bit. Corners the file
+  /// lacks are computed as without it. A malformed table (or one of another model revision or
+  /// settings) is an error naming "drift_table", the file and its problem; a table that is not
+  /// there (a scene file copied elsewhere) is not: drift_table_problem says so, and the runs that
+  /// use the local law report it as an ignored setting (stderr and the run's JSON). Written by
   /// `rheofeed run SCENE --drift-table FILE`; the shipped local-law scenes name theirs.
   std::string drift_table;
+  /// Why drift_table was not read (the file is not there), or empty.
+  std::string drift_table_problem;
   /// The corners read from drift_table (null until the scene is loaded from a file).
   std::shared_ptr<const std::vector<DriftTableCorner>> drift_table_corners;
 
