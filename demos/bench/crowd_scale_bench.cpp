@@ -298,9 +298,12 @@ std::string markdownTables(const std::vector<const Row*>& rows, const std::strin
     const char* separator = " ";
     for (const Stage& s : kStages) {
       const double growth = cpuPerStep(b, s) - cpuPerStep(a, s);
-      md << separator << s.name << " N^"
-         << formatNumber(slope(a.parts, cpuPerStep(a, s), b.parts, cpuPerStep(b, s)), 3) << " ("
-         << ms(cpuPerStep(a, s)) << " -> " << ms(cpuPerStep(b, s)) << ")";
+      // A stage that is zero at either end (the table fill) has no slope.
+      const double stage_slope = slope(a.parts, cpuPerStep(a, s), b.parts, cpuPerStep(b, s));
+      md << separator << s.name << " "
+         << (std::isnan(stage_slope) ? std::string("(no slope)")
+                                     : "N^" + formatNumber(stage_slope, 3))
+         << " (" << ms(cpuPerStep(a, s)) << " -> " << ms(cpuPerStep(b, s)) << ")";
       separator = ", ";
       if (growth > top_growth) {
         top_growth = growth;
