@@ -19,6 +19,12 @@ using rheofeed::scene::Scene;
 
 // The local law's point-mass results of the shipped scenes, relative to demos/scenes/.
 constexpr const char* kDriftTable = "tables/drift_table.json";
+// The end of both scenes' comments: what kDriftTable is, and where the numbers are.
+const std::string kDriftTableNote =
+    "drift_table: the local law's point-mass results of the shipped scenes "
+    "(tables/drift_table.json, written by `rheofeed run SCENE --drift-table "
+    "demos/scenes/tables/drift_table.json`), so that a first run skips those model runs. Numbers "
+    "and commands: demos/results/bowl_feeder.md.";
 
 // Inserts `"comment": text,` as the first member of the object that `anchor` opens (anchor ends
 // with '{') or, when it does not end with '{', on the line after `anchor` (a member line), at
@@ -71,10 +77,8 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
         "into the bowl over a return chute, and leave lying flat through a tangential outlet. The "
         "rheonomic runs use the local vibration law (no calibration). Outputs: output rate and "
         "cumulative count at the exit plane, first part out, exit "
-        "orientation, mean height against time, angular drift. drift_table: the local law's "
-        "point-mass results of the shipped scenes (tables/drift_table.json, written by `rheofeed "
-        "run SCENE --drift-table demos/scenes/tables/drift_table.json`), so that a first run "
-        "skips those model runs. Numbers and commands: demos/results/bowl_feeder.md.");
+        "orientation, mean height against time, angular drift. " +
+            kDriftTableNote);
   } else {
     insertComment(
         json, "{",
@@ -82,11 +86,8 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
         "bowl_feeder_primitives`; written by dump_builtin_scene from builtin_scenes.hpp "
         "bowlFeederScene()): the same bowl, tooling and outlet as bowl_feeder_fill. Rheonomic at "
         "h = 0.01 s (the paper's step) on the local vibration law, with no nut lost or sunk in 60 "
-        "s, where the mesh bowl of bowl_feeder.json loses 5 of 12 in 12 s at that step. "
-        "drift_table: the local law's point-mass results of the shipped scenes "
-        "(tables/drift_table.json, written by `rheofeed run SCENE --drift-table "
-        "demos/scenes/tables/drift_table.json`), so that a first run skips those model runs. "
-        "Numbers and commands: demos/results/bowl_feeder.md.");
+        "s, where the mesh bowl of bowl_feeder.json loses 5 of 12 in 12 s at that step. " +
+            kDriftTableNote);
   }
   insertComment(
       json, "\"name\": \"bowl\",",
