@@ -51,6 +51,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/coulomb_residual.hpp"
 #include "common/builtin_scenes.hpp"
 #include "rheofeed/ccp/cone.hpp"
 #include "rheofeed/ccp/fc3d_reader.hpp"
@@ -95,23 +96,7 @@ struct NamedProblem {
   ccp::Problem problem;
 };
 
-// The Coulomb residual of solver.hpp, computed independently of the solvers: per contact the
-// natural map of De Saxce's velocity with the step s_i = 3 / trace(N_ii), divided by s_i, and
-// the norm relative to max(||r||, ||N gamma||).
-double coulombResidual(const ccp::Problem& p, const Eigen::VectorXd& gamma) {
-  const Eigen::VectorXd u = p.contactVelocity(gamma);
-  double error = 0.0;
-  for (Eigen::Index i = 0; i < p.numContacts(); ++i) {
-    const double step = 3.0 / p.diagonalBlock(i).trace();
-    Eigen::Vector3d v = u.segment<3>(3 * i);
-    v[0] += p.mu[i] * std::hypot(v[1], v[2]);
-    const Eigen::Vector3d g = gamma.segment<3>(3 * i);
-    error += ((g - ccp::projectOntoCone(g - step * v, p.mu[i])) / step).squaredNorm();
-  }
-  const double scale = std::max(p.r.norm(), (u - p.r).norm());
-  if (error == 0.0) return 0.0;
-  return scale > 0.0 ? std::sqrt(error) / scale : std::numeric_limits<double>::infinity();
-}
+using rheofeed::bench::coulombResidual;
 
 struct Run {
   std::string problem, source, solver;

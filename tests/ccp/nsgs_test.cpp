@@ -31,15 +31,6 @@ constexpr double kConeRoundoff = 1e-12;
 constexpr double kGravity = 9.81;  // m/s^2
 constexpr double kPi = 3.14159265358979323846;
 
-const char* const kFiles[] = {"FrictionContact3D_1c.dat",
-                              "FC3D_Example1.dat",
-                              "Rover4396.dat",
-                              "Rover1039.dat",
-                              "Rover3865.dat",
-                              "NESpheres_10_1.dat",
-                              "BoxesStack1-i100000-32.hdf5.dat",
-                              "Capsules-i101-404.dat"};
-
 class NsgsFc3d : public testing::TestWithParam<const char*> {};
 
 TEST_P(NsgsFc3d, SolvesTheCoulombLawTo1e8) {
@@ -67,33 +58,10 @@ TEST_P(NsgsFc3d, SolvesTheCoulombLawTo1e8) {
   EXPECT_LE(violation, kConeRoundoff * (1.0 + gamma.norm()));
 }
 
-INSTANTIATE_TEST_SUITE_P(SiconosData, NsgsFc3d, testing::ValuesIn(kFiles),
-                         [](const testing::TestParamInfo<const char*>& param_info) {
-                           std::string name = param_info.param;
-                           name = name.substr(0, name.find(".dat"));
-                           for (char& c : name) {
-                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-                           }
-                           return name;
-                         });
+INSTANTIATE_TEST_SUITE_P(SiconosData, NsgsFc3d, testing::ValuesIn(test::kFc3dFiles),
+                         test::fc3dTestName);
 
-// One step of a point mass m resting on an incline of angle theta (contact frame: n out of the
-// plane, t1 down the slope, t2 across), with velocity zero at the start of the step of length
-// h: r = h g (-cos theta, sin theta, 0), N = I / m.
-Problem inclineStep(double mass, double theta, double mu, double h, bool matrix_free) {
-  Eigen::VectorXd r(3);
-  r << -h * kGravity * std::cos(theta), h * kGravity * std::sin(theta), 0.0;
-  Eigen::VectorXd friction(1);
-  friction << mu;
-  if (!matrix_free) {
-    return Problem::makeDense(Eigen::Matrix3d::Identity() / mass, r, friction);
-  }
-  SparseMatrix d(3, 3), minv(3, 3);
-  d.setIdentity();
-  minv.setIdentity();
-  minv *= 1.0 / mass;
-  return Problem::makeMatrixFree(d, minv, r, friction);
-}
+using test::inclineStep;
 
 class NsgsIncline : public testing::TestWithParam<bool> {};
 
@@ -104,12 +72,7 @@ TEST_P(NsgsIncline, SticksBelowTheFrictionAngle) {
   NsgsSolver solver;
   Eigen::VectorXd gamma;
   ASSERT_EQ(solver.solve(problem, gamma).status, Status::Converged);
-  const Eigen::VectorXd u = problem.contactVelocity(gamma);
-  // Stick: the part stays at rest; the impulses carry the weight's two components.
-  EXPECT_NEAR(u.norm(), 0.0, 1e-12);
-  EXPECT_NEAR(gamma[0], mass * h * kGravity * std::cos(theta), 1e-12);
-  EXPECT_NEAR(gamma[1], -mass * h * kGravity * std::sin(theta), 1e-12);
-  EXPECT_NEAR(gamma[2], 0.0, 1e-12);
+  test::expectInclineLaw(problem, gamma, mass, theta, mu, h, 1e-12, 1e-12, 1e-9);
 }
 
 TEST_P(NsgsIncline, SlidesAboveTheFrictionAngleWithTheExactAcceleration) {
@@ -119,21 +82,10 @@ TEST_P(NsgsIncline, SlidesAboveTheFrictionAngleWithTheExactAcceleration) {
   NsgsSolver solver;
   Eigen::VectorXd gamma;
   ASSERT_EQ(solver.solve(problem, gamma).status, Status::Converged);
-  const Eigen::VectorXd u = problem.contactVelocity(gamma);
-  // Slide: no separation (true Coulomb, not the relaxation's mu |u_t|), friction mu N against
-  // the slip, acceleration g (sin theta - mu cos theta) down the slope.
-  const double acceleration = kGravity * (std::sin(theta) - mu * std::cos(theta));
-  EXPECT_NEAR(u[0], 0.0, 1e-12);
-  EXPECT_NEAR(u[1] / h, acceleration, 1e-9);
-  EXPECT_NEAR(u[2], 0.0, 1e-12);
-  EXPECT_NEAR(gamma[0], mass * h * kGravity * std::cos(theta), 1e-12);
-  EXPECT_NEAR(gamma[1], -mu * gamma[0], 1e-12);
+  test::expectInclineLaw(problem, gamma, mass, theta, mu, h, 1e-12, 1e-12, 1e-9);
 }
 
-INSTANTIATE_TEST_SUITE_P(DenseAndMatrixFree, NsgsIncline, testing::Bool(),
-                         [](const testing::TestParamInfo<bool>& param_info) {
-                           return std::string(param_info.param ? "MatrixFree" : "Dense");
-                         });
+INSTANTIATE_TEST_SUITE_P(DenseAndMatrixFree, NsgsIncline, testing::Bool(), test::formName);
 
 TEST(Nsgs, WarmStartFromTheSolutionOfARepeatedProblemTakesFewerSweeps) {
   const Problem problem = readFc3dFile(std::string(RHEOFEED_FC3D_DIR) + "/Capsules-i101-404.dat");
@@ -162,27 +114,9 @@ TEST(Nsgs, WarmStartFromTheSolutionOfARepeatedProblemTakesFewerSweeps) {
 TEST(Nsgs, DenseAndMatrixFreeFormsGiveTheSameVelocities) {
   // Twelve contacts on four bodies (6 dofs each) with coupled rows: a random sparse D, a block
   // diagonal M^-1 of masses and inertias.
-  const int bodies = 4, nc = 12;
-  SparseMatrix d(6 * bodies, 3 * nc), minv(6 * bodies, 6 * bodies);
-  std::srand(7);
-  auto random = [] { return 2.0 * std::rand() / RAND_MAX - 1.0; };
-  std::vector<Eigen::Triplet<double>> entries;
-  for (int i = 0; i < nc; ++i) {
-    for (int side = 0; side < 2; ++side) {
-      const int body = (i + side * (1 + i % 3)) % bodies;
-      for (int k = 0; k < 3; ++k) {
-        for (int q = 0; q < 6; ++q) entries.emplace_back(6 * body + q, 3 * i + k, random());
-      }
-    }
-  }
-  d.setFromTriplets(entries.begin(), entries.end());
-  entries.clear();
-  for (int q = 0; q < 6 * bodies; ++q) entries.emplace_back(q, q, 0.5 + 0.1 * (q % 5));
-  minv.setFromTriplets(entries.begin(), entries.end());
-  Eigen::VectorXd r(3 * nc), mu(nc);
-  for (int i = 0; i < 3 * nc; ++i) r[i] = random();
-  for (int i = 0; i < nc; ++i) mu[i] = 0.3 + 0.05 * (i % 4);
-  const Problem free_form = Problem::makeMatrixFree(d, minv, r, mu);
+  const Problem free_form = test::coupledProblem(4, 12, 0.0);
+  const Eigen::VectorXd& r = free_form.r;
+  const Eigen::VectorXd& mu = free_form.mu;
   const Problem dense_form = Problem::makeDense(free_form.denseDelassus(), r, mu);
   NsgsSettings settings;
   settings.tolerance = 1e-12;

@@ -8,12 +8,16 @@
 #include <gtest/gtest.h>
 #include <Eigen/Core>
 #include <Eigen/QR>
+#include "rheofeed/ccp/problem.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <random>
 #include <string>
+#include <vector>
 
 /// Expects `needle` to be a substring of the string `haystack` (gtest's IsSubstring, so the
 /// failure message shows both).
@@ -136,6 +140,102 @@ inline Eigen::VectorXd randomVector(Eigen::Index n, double scale, std::mt19937& 
   Eigen::VectorXd v(n);
   for (Eigen::Index i = 0; i < n; ++i) v(i) = normal(rng);
   return v;
+}
+
+/// The Siconos fc3d problems of tests/data/fc3d every Coulomb solver's test runs.
+inline const char* const kFc3dFiles[] = {"FrictionContact3D_1c.dat",
+                                         "FC3D_Example1.dat",
+                                         "Rover4396.dat",
+                                         "Rover1039.dat",
+                                         "Rover3865.dat",
+                                         "NESpheres_10_1.dat",
+                                         "BoxesStack1-i100000-32.hdf5.dat",
+                                         "Capsules-i101-404.dat"};
+
+/// A test name from an fc3d file name (non-alphanumerics become '_').
+inline std::string fc3dTestName(const testing::TestParamInfo<const char*>& param_info) {
+  std::string name = param_info.param;
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  return name;
+}
+
+/// "Dense" or "MatrixFree" for a test parameterised on the matrix-free form.
+inline std::string formName(const testing::TestParamInfo<bool>& param_info) {
+  return param_info.param ? "MatrixFree" : "Dense";
+}
+
+/// One step of a point mass `mass` (kg) at rest on an incline of angle `theta` (rad) with
+/// friction `mu`, step `h` (s), gravity 9.81 m/s^2 (contact frame: n out of the plane, t1 down
+/// the slope, t2 across): r = h g (-cos theta, sin theta, 0), N = I / m, dense or matrix-free.
+inline Problem inclineStep(double mass, double theta, double mu, double h, bool matrix_free) {
+  const double g = 9.81;
+  Eigen::VectorXd r(3);
+  r << -h * g * std::cos(theta), h * g * std::sin(theta), 0.0;
+  Eigen::VectorXd friction(1);
+  friction << mu;
+  if (!matrix_free) return Problem::makeDense(Eigen::Matrix3d::Identity() / mass, r, friction);
+  SparseMatrix d(3, 3), minv(3, 3);
+  d.setIdentity();
+  minv.setIdentity();
+  minv *= 1.0 / mass;
+  return Problem::makeMatrixFree(d, minv, r, friction);
+}
+
+/// The incline step's closed form (inclineStep, gravity 9.81 m/s^2) checked on `gamma`: below
+/// the friction angle the mass stays at rest and the impulses carry the weight's two components;
+/// above it, it slides with no separation (true Coulomb, not the relaxation's mu |u_t|), friction
+/// mu N against the slip and acceleration g (sin theta - mu cos theta). Absolute tolerances on
+/// impulses (N s), velocities (m/s) and the acceleration (m/s^2).
+inline void expectInclineLaw(const Problem& problem, const Eigen::VectorXd& gamma, double mass,
+                             double theta, double mu, double h, double impulse_tol,
+                             double velocity_tol, double acceleration_tol) {
+  const double g = 9.81;
+  const Eigen::VectorXd u = problem.contactVelocity(gamma);
+  const double weight = mass * h * g;  // N s
+  EXPECT_NEAR(gamma[0], weight * std::cos(theta), impulse_tol);
+  if (std::tan(theta) <= mu) {
+    EXPECT_NEAR(u.norm(), 0.0, velocity_tol);
+    EXPECT_NEAR(gamma[1], -weight * std::sin(theta), impulse_tol);
+    EXPECT_NEAR(gamma[2], 0.0, impulse_tol);
+    return;
+  }
+  EXPECT_NEAR(u[0], 0.0, velocity_tol);
+  EXPECT_NEAR(u[1] / h, g * (std::sin(theta) - mu * std::cos(theta)), acceleration_tol);
+  EXPECT_NEAR(u[2], 0.0, velocity_tol);
+  EXPECT_NEAR(gamma[1], -mu * gamma[0], impulse_tol);
+}
+
+/// A matrix-free problem with `nc` contacts on `bodies` bodies (6 dofs each), each contact
+/// coupling two bodies through random rows of D (seeded with 7), M^-1 diagonal; with
+/// `compliance` c > 0 (1/kg) the reference world's N + c I is built as it does
+/// (reference/world_contacts.cpp): one virtual unit-mass coordinate per contact row with D entry
+/// sqrt(c). Friction 0.3-0.45, r random in [-1, 1] m/s.
+inline Problem coupledProblem(int bodies, int nc, double compliance) {
+  const int rigid = 6 * bodies, rows = rigid + (compliance > 0.0 ? 3 * nc : 0);
+  SparseMatrix d(rows, 3 * nc), minv(rows, rows);
+  std::srand(7);
+  auto random = [] { return 2.0 * std::rand() / RAND_MAX - 1.0; };
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 0; i < nc; ++i) {
+    for (int side = 0; side < 2; ++side) {
+      const int body = (i + side * (1 + i % 3)) % bodies;
+      for (int k = 0; k < 3; ++k) {
+        for (int q = 0; q < 6; ++q) entries.emplace_back(6 * body + q, 3 * i + k, random());
+      }
+    }
+  }
+  for (int k = rigid; k < rows; ++k) entries.emplace_back(k, k - rigid, std::sqrt(compliance));
+  d.setFromTriplets(entries.begin(), entries.end());
+  entries.clear();
+  for (int q = 0; q < rigid; ++q) entries.emplace_back(q, q, 0.5 + 0.1 * (q % 5));
+  for (int k = rigid; k < rows; ++k) entries.emplace_back(k, k, 1.0);
+  minv.setFromTriplets(entries.begin(), entries.end());
+  Eigen::VectorXd r(3 * nc), mu(nc);
+  for (int i = 0; i < 3 * nc; ++i) r[i] = random();
+  for (int i = 0; i < nc; ++i) mu[i] = 0.3 + 0.05 * (i % 4);
+  return Problem::makeMatrixFree(d, minv, r, mu);
 }
 
 }  // namespace rheofeed::ccp::test

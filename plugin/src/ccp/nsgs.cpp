@@ -38,12 +38,6 @@ namespace rheofeed::ccp {
 
 namespace {
 
-std::string format(const char* fmt, double a) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof buffer, fmt, a);
-  return std::string(buffer);
-}
-
 // Share of the global tolerance a group's local solve must reach (relative to the group's own
 // velocity scale, which is at most the problem's).
 constexpr double kGroupToleranceShare = 0.01;
@@ -69,45 +63,42 @@ const char* toString(ContactOrder order) {
 }
 
 std::string NsgsSettings::validate() const {
-  if (max_iterations < 1) return format("max_iterations = %g must be >= 1", max_iterations);
-  if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) {
-    return format("tolerance = %g must be finite and >= 0", tolerance);
-  }
-  if (!(residual_rho > 0.0) || !std::isfinite(residual_rho)) {
-    return format("residual_rho = %g must be finite and > 0", residual_rho);
-  }
-  if (!(omega > 0.0 && omega < 2.0)) return format("omega = %g must be in (0, 2)", omega);
+  if (max_iterations < 1) return detail::format("max_iterations = %g must be >= 1", max_iterations);
+  if (!(omega > 0.0 && omega < 2.0)) return detail::format("omega = %g must be in (0, 2)", omega);
   if (order != ContactOrder::Given && order != ContactOrder::Alternating &&
       order != ContactOrder::Shuffled) {
     return "order is not Given, Alternating or Shuffled";
   }
   if (!(proximal_weight >= 0.0) || !std::isfinite(proximal_weight)) {
-    return format("proximal_weight = %g must be finite and >= 0", proximal_weight);
+    return detail::format("proximal_weight = %g must be finite and >= 0", proximal_weight);
   }
   if (local_newton_iterations < 1) {
-    return format("local_newton_iterations = %g must be >= 1", local_newton_iterations);
+    return detail::format("local_newton_iterations = %g must be >= 1", local_newton_iterations);
   }
   if (local_projection_iterations < 0) {
-    return format("local_projection_iterations = %g must be >= 0", local_projection_iterations);
+    return detail::format("local_projection_iterations = %g must be >= 0",
+                          local_projection_iterations);
   }
   if (!(local_tolerance > 0.0) || !std::isfinite(local_tolerance)) {
-    return format("local_tolerance = %g must be finite and > 0", local_tolerance);
+    return detail::format("local_tolerance = %g must be finite and > 0", local_tolerance);
   }
-  if (refresh_interval < 1) return format("refresh_interval = %g must be >= 1", refresh_interval);
+  if (refresh_interval < 1)
+    return detail::format("refresh_interval = %g must be >= 1", refresh_interval);
   if (global_newton_interval < 0) {
-    return format("global_newton_interval = %g must be >= 0", global_newton_interval);
+    return detail::format("global_newton_interval = %g must be >= 0", global_newton_interval);
   }
   if (global_newton_iterations < 1) {
-    return format("global_newton_iterations = %g must be >= 1", global_newton_iterations);
+    return detail::format("global_newton_iterations = %g must be >= 1", global_newton_iterations);
   }
   if (global_newton_max_contacts < 0) {
-    return format("global_newton_max_contacts = %g must be >= 0", global_newton_max_contacts);
+    return detail::format("global_newton_max_contacts = %g must be >= 0",
+                          global_newton_max_contacts);
   }
   if (!(global_newton_step_limit > 0.0) || !std::isfinite(global_newton_step_limit)) {
-    return format("global_newton_step_limit = %g must be finite and > 0", global_newton_step_limit);
+    return detail::format("global_newton_step_limit = %g must be finite and > 0",
+                          global_newton_step_limit);
   }
-  if (!(time_limit_s >= 0.0)) return format("time_limit_s = %g must be >= 0", time_limit_s);
-  return {};
+  return detail::checkStopping(tolerance, residual_rho, time_limit_s);
 }
 
 struct NsgsSolver::Workspace {
@@ -324,14 +315,14 @@ struct NsgsRun {
       }
       if (current <= settings.tolerance) return Status::Converged;
       if (deadline.expired()) {
-        result.message = format("time limit of %g s reached", deadline.limit());
+        result.message = detail::format("time limit of %g s reached", deadline.limit());
         gamma = best;
         return Status::MaxIterations;
       }
     }
     gamma = best;
-    result.message =
-        format("NSGS: Coulomb residual %g above the tolerance after the budget", best_residual);
+    result.message = detail::format(
+        "NSGS: Coulomb residual %g above the tolerance after the budget", best_residual);
     return Status::MaxIterations;
   }
 };

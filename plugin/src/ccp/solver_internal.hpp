@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
-// Internal pieces shared by solver.cpp, pgs.cpp and apgd.cpp: the workspace, the Delassus
-// products, the residual and the inner (relaxed) solvers. Not installed.
+// Internal pieces shared by solver.cpp, pgs.cpp, apgd.cpp, nsgs.cpp and ipm.cpp: the workspace,
+// the Delassus products, the residual, the inner (relaxed) solvers and the settings checks. Not
+// installed.
 
 #include "rheofeed/ccp/problem.hpp"
 #include "rheofeed/ccp/solver.hpp"
@@ -11,9 +12,31 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <string>
 
 namespace rheofeed::ccp::detail {
+
+/// `fmt` (one %g) applied to `a`: the settings checks' messages.
+inline std::string format(const char* fmt, double a) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, fmt, a);
+  return std::string(buffer);
+}
+
+/// The checks NsgsSettings and IpmSettings share: a finite tolerance >= 0, a finite
+/// residual_rho > 0 and a time limit >= 0 (s). Empty when they pass, else the message.
+inline std::string checkStopping(double tolerance, double residual_rho, double time_limit_s) {
+  if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) {
+    return format("tolerance = %g must be finite and >= 0", tolerance);
+  }
+  if (!(residual_rho > 0.0) || !std::isfinite(residual_rho)) {
+    return format("residual_rho = %g must be finite and > 0", residual_rho);
+  }
+  if (!(time_limit_s >= 0.0)) return format("time_limit_s = %g must be >= 0", time_limit_s);
+  return {};
+}
 
 /// Range of squared norms summed directly by safeNorm(): below, subnormal squares lose digits;
 /// above, the sum may have overflowed.

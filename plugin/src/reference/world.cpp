@@ -69,6 +69,10 @@ std::string settingsProblem(const Settings& settings) {
     bad << "Settings::coulomb_solver is not Nsgs or RelaxedFixedPoint";
   else if (std::string nsgs = settings.nsgs.validate(); !nsgs.empty())
     bad << "Settings::nsgs: " << nsgs;
+  else if (std::string ipm = settings.ipm.validate(); !ipm.empty())
+    bad << "Settings::ipm: " << ipm;
+  else if (settings.ipm_max_contacts < 0)
+    bad << "Settings::ipm_max_contacts = " << settings.ipm_max_contacts << " must be >= 0";
   return bad.str();
 }
 

@@ -190,6 +190,29 @@ void solveStage(StepContext& c) {
     settings.time_limit_s = cfg.solver.time_limit_s;
     settings.warm_start = true;  // gamma is zero without Settings::warm_start
     report.solve = s.nsgs.solve(s.problem, gamma);
+    if (cfg.ipm_after_nsgs && report.solve.status == ccp::Status::MaxIterations &&
+        c.nc <= cfg.ipm_max_contacts) {
+      ccp::IpmSettings& ipm = s.ipm.settings();
+      ipm = cfg.ipm;
+      ipm.tolerance = cfg.solver.tolerance;
+      ipm.residual_rho = cfg.solver.residual_rho;
+      ipm.time_limit_s = cfg.solver.time_limit_s;
+      ipm.warm_start = true;
+      s.ipm_gamma = gamma;
+      const ccp::Result second = s.ipm.solve(s.problem, s.ipm_gamma);
+      report.ipm_tried = true;
+      if ((second.status == ccp::Status::Converged ||
+           second.status == ccp::Status::MaxIterations) &&
+          second.coulomb_distance < report.solve.coulomb_distance) {
+        const double first_time = report.solve.solve_time_s;
+        report.solve = second;
+        report.solve.solve_time_s += first_time;
+        gamma = s.ipm_gamma;
+        report.ipm_kept = true;
+      } else {
+        report.solve.solve_time_s += second.solve_time_s;
+      }
+    }
     report.coulomb_residual = report.solve.coulomb_distance;
   } else {
     s.solver.settings() = cfg.solver;

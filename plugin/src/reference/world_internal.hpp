@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "ode_vec.hpp"  // the ODE <-> rheofeed conversions (toVec3, setGeomPose)
+#include "rheofeed/ccp/ipm.hpp"
 #include "rheofeed/ccp/nsgs.hpp"
 #include "rheofeed/ccp/problem.hpp"
 #include "rheofeed/ccp/solver.hpp"
@@ -141,6 +142,8 @@ struct WorldState {
   StepObserver observer;
   ccp::Solver solver;
   ccp::NsgsSolver nsgs;
+  ccp::IpmSolver ipm;
+  Eigen::VectorXd ipm_gamma;
   std::vector<RawContact> raw;
   std::vector<ContactImpulse> contacts;
   // Last step's contacts per geom pair (dCollide's order): point and impulse on g1's body, both

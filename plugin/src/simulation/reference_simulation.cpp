@@ -109,6 +109,10 @@ class ReferenceSimulation final : public PartSimulation {
            << "nothing";
       reportFirst("Coulomb fallback step", line.str());
     }
+    if (report.ipm_tried) {
+      ++health_.ipm_second_solve_steps;
+      if (report.solve.status == ccp::Status::Converged) ++health_.ipm_converged_steps;
+    }
     if (report.contacts > 0 && report.solve.status != ccp::Status::Converged) {
       ++health_.solver_unconverged_steps;
       std::ostringstream line;

@@ -109,6 +109,10 @@ std::string healthSummary(const RunHealth& h, int parts) {
   if (h.solver_unconverged_steps > 0) {
     s << separator << h.solver_unconverged_steps << " of " << h.steps
       << " steps with an unconverged contact solve";
+    if (h.ipm_second_solve_steps > 0) {
+      s << " (" << h.ipm_second_solve_steps << " left unconverged by NSGS were solved again by "
+        << "the interior-point fixed point, " << h.ipm_converged_steps << " of them converged)";
+    }
     separator = "; ";
   }
   if (h.friction_dropped_contacts > 0) {

@@ -176,6 +176,29 @@ struct NsgsSettings {
   std::string validate() const;
 };
 
+/// Settings of the interior-point solver (ipm.hpp: IpmSolver). Checked at each solve.
+struct IpmSettings {
+  /// Interior-point iterations of one convex solve (>= 1).
+  int max_iterations = 100;
+  /// True Coulomb: stop when the Coulomb residual (Result::coulomb_distance, dimensionless) is
+  /// at or below this (finite, >= 0). Convex solves: their own residual's target.
+  double tolerance = 1e-8;
+  /// Each convex solve of the fixed point stops at this share of `tolerance` (0 < share <= 1).
+  double inner_tolerance_share = 0.1;
+  /// Fixed-point (outer) iterations of IpmSolver::solve (>= 1).
+  int max_outer_iterations = 30;
+  /// Multiplier of the residual's natural-map step, as Settings::residual_rho (finite, > 0).
+  double residual_rho = 1.0;
+  /// True Coulomb: start the shift from the incoming gamma's velocities when it has the right
+  /// size and finite entries (else from s = 0).
+  bool warm_start = true;
+  /// Wall-clock budget of one solve (s); 0 means none.
+  double time_limit_s = 0.0;
+
+  /// Empty when usable, else a message naming the bad field and its value.
+  std::string validate() const;
+};
+
 /// What a solve produced. Measures are defined in this file's header comment; they are NaN
 /// when not computed (NotRun, InvalidInput).
 struct Result {
