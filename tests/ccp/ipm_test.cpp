@@ -59,6 +59,31 @@ using test::inclineStep;
 
 class IpmIncline : public testing::TestWithParam<bool> {};
 
+// Steps of the main demo that NSGS, the reference world's solver, leaves above the scene's
+// Coulomb tolerance 1e-6 (tests/data/trough_steps): the interior-point fixed point meets it, the
+// residual recomputed here with De Saxce's velocity.
+class IpmTroughStep : public testing::TestWithParam<const char*> {};
+
+TEST_P(IpmTroughStep, MeetsTheSceneToleranceWhereNsgsStalls) {
+  const std::string path = std::string(RHEOFEED_FC3D_DIR) + "/../trough_steps/" + GetParam();
+  ASSERT_TRUE(std::filesystem::exists(path)) << "missing " << path;
+  const Problem problem = readFc3dFile(path);
+  IpmSettings settings;
+  settings.tolerance = 1e-6;
+  IpmSolver solver(settings);
+  Eigen::VectorXd gamma;
+  const Result result = solver.solve(problem, gamma);
+  EXPECT_EQ(result.status, Status::Converged)
+      << toString(result.status) << " after " << result.outer_iterations << " outer iterations, "
+      << result.coulomb_distance << " " << result.message;
+  EXPECT_LE(test::relativeResidual(problem.delassus, gamma, problem.r, problem.mu, true), 1e-6);
+  EXPECT_LE(test::coneViolation(gamma, problem.mu), kConeRoundoff * (1.0 + gamma.norm()));
+}
+
+INSTANTIATE_TEST_SUITE_P(MainDemo, IpmTroughStep,
+                         testing::Values("trough_fail_0.40.dat", "trough_fail_1.38.dat"),
+                         test::fc3dTestName);
+
 // Tolerances: 1e-10 of the weight's impulse and of h g, 1e-8 g on the acceleration (the solve
 // asks for a residual of 1e-12).
 void expectIncline(double theta, bool matrix_free, bool sliding) {

@@ -74,6 +74,12 @@ TEST(ReferenceBadInput, ConstructorRefusesBadSettingsNamingThem) {
   s = defaultSettings();
   s.solver.coulomb_outer_iterations = -3;
   expectRefusedSettings(s, {"solver", "coulomb_outer_iterations", "-3"});
+  s = defaultSettings();
+  s.ipm_rounds = -1;
+  expectRefusedSettings(s, {"ipm_rounds", "-1"});
+  s = defaultSettings();
+  s.ipm.max_outer_iterations = 0;
+  expectRefusedSettings(s, {"ipm", "max_outer_iterations", "0"});
 }
 
 /// A box resting on the ground, in contact from the first step.

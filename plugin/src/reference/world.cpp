@@ -71,6 +71,8 @@ std::string settingsProblem(const Settings& settings) {
     bad << "Settings::nsgs: " << nsgs;
   else if (std::string ipm = settings.ipm.validate(); !ipm.empty())
     bad << "Settings::ipm: " << ipm;
+  else if (settings.ipm_rounds < 0)
+    bad << "Settings::ipm_rounds = " << settings.ipm_rounds << " must be >= 0";
   else if (settings.ipm_max_contacts < 0)
     bad << "Settings::ipm_max_contacts = " << settings.ipm_max_contacts << " must be >= 0";
   return bad.str();

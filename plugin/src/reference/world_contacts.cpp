@@ -190,27 +190,33 @@ void solveStage(StepContext& c) {
     settings.time_limit_s = cfg.solver.time_limit_s;
     settings.warm_start = true;  // gamma is zero without Settings::warm_start
     report.solve = s.nsgs.solve(s.problem, gamma);
-    if (cfg.ipm_after_nsgs && report.solve.status == ccp::Status::MaxIterations &&
-        c.nc <= cfg.ipm_max_contacts) {
+    // Alternate with the interior-point fixed point while unconverged: each solver starts from
+    // the best iterate so far and the lower Coulomb residual is kept (Settings::ipm_rounds).
+    if (report.solve.status == ccp::Status::MaxIterations && c.nc <= cfg.ipm_max_contacts) {
       ccp::IpmSettings& ipm = s.ipm.settings();
       ipm = cfg.ipm;
       ipm.tolerance = cfg.solver.tolerance;
       ipm.residual_rho = cfg.solver.residual_rho;
       ipm.time_limit_s = cfg.solver.time_limit_s;
       ipm.warm_start = true;
-      s.ipm_gamma = gamma;
-      const ccp::Result second = s.ipm.solve(s.problem, s.ipm_gamma);
-      report.ipm_tried = true;
-      if ((second.status == ccp::Status::Converged ||
-           second.status == ccp::Status::MaxIterations) &&
-          second.coulomb_distance < report.solve.coulomb_distance) {
-        const double first_time = report.solve.solve_time_s;
-        report.solve = second;
-        report.solve.solve_time_s += first_time;
-        gamma = s.ipm_gamma;
-        report.ipm_kept = true;
-      } else {
-        report.solve.solve_time_s += second.solve_time_s;
+      auto attempt = [&](auto& solver) {
+        s.ipm_gamma = gamma;
+        const ccp::Result next = solver.solve(s.problem, s.ipm_gamma);
+        const double earlier = report.solve.solve_time_s;
+        if ((next.status == ccp::Status::Converged || next.status == ccp::Status::MaxIterations) &&
+            next.coulomb_distance < report.solve.coulomb_distance) {
+          report.solve = next;
+          gamma = s.ipm_gamma;
+        }
+        report.solve.solve_time_s = earlier + next.solve_time_s;
+        return next.status;
+      };
+      for (int round = 0;
+           round < cfg.ipm_rounds && report.solve.status == ccp::Status::MaxIterations; ++round) {
+        ++report.ipm_rounds;
+        if (attempt(s.ipm) == ccp::Status::InvalidInput) break;  // e.g. a contact with mu = 0
+        if (report.solve.status != ccp::Status::MaxIterations) break;
+        attempt(s.nsgs);
       }
     }
     report.coulomb_residual = report.solve.coulomb_distance;

@@ -109,7 +109,7 @@ class ReferenceSimulation final : public PartSimulation {
            << "nothing";
       reportFirst("Coulomb fallback step", line.str());
     }
-    if (report.ipm_tried) {
+    if (report.ipm_rounds > 0) {
       ++health_.ipm_second_solve_steps;
       if (report.solve.status == ccp::Status::Converged) ++health_.ipm_converged_steps;
     }

@@ -111,7 +111,8 @@ std::string healthSummary(const RunHealth& h, int parts) {
       << " steps with an unconverged contact solve";
     if (h.ipm_second_solve_steps > 0) {
       s << " (" << h.ipm_second_solve_steps << " left unconverged by NSGS were solved again by "
-        << "the interior-point fixed point, " << h.ipm_converged_steps << " of them converged)";
+        << "the interior-point fixed point and NSGS in turn, " << h.ipm_converged_steps
+        << " of them converged)";
     }
     separator = "; ";
   }

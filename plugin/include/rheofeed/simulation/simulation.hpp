@@ -111,9 +111,9 @@ struct RunHealth {
   /// (iteration limit or numerical issue; 0 for ODE, which reports no convergence).
   long coulomb_fallback_steps = 0;
   long solver_unconverged_steps = 0;
-  /// Reference engine with NSGS: steps solved a second time by the interior-point fixed point
-  /// after NSGS ended unconverged (reference::Settings::ipm_after_nsgs), and those of them it
-  /// converged (they are not in solver_unconverged_steps).
+  /// Reference engine with NSGS: steps that NSGS left unconverged and that were solved again by
+  /// the interior-point fixed point alternating with NSGS (reference::Settings::ipm_rounds), and
+  /// those of them that then converged (they are not in solver_unconverged_steps).
   long ipm_second_solve_steps = 0;
   long ipm_converged_steps = 0;
   /// Reference engine: contacts whose friction the Coulomb fallback had to drop to end its
