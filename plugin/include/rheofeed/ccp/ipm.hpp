@@ -10,8 +10,9 @@
 /// problem.hpp, `s_i = mu_i ||u_t,i||` at the solution is the true Coulomb law (De Saxce's
 /// modified velocity). Unlike the first-order solvers, an IPM's iteration count does not depend
 /// on the conditioning of N: the crowded problems of the reference world (a rigid Delassus
-/// operator plus the compliance cfm / h, condition numbers of 1e7) are solved to 1e-9 in about
-/// 20 iterations (demos/results/reference_judges.md).
+/// operator plus the compliance cfm / h, condition numbers of 1e7) are solved to 1e-8 in 13-27
+/// iterations (demos/results/coulomb_stall_probe_trough.md). In double precision the method
+/// stalls near 1e-9 (the relative residual of ccp/solver.hpp).
 ///
 /// Method (ours; after the cone QP solver of CVXOPT, Vandenberghe 2010): variables
 /// `x_i = (mu_i gamma_n, gamma_t)` in the Lorentz cone, Nesterov-Todd scaling, Mehrotra's
@@ -23,9 +24,10 @@
 /// True Coulomb (IpmSolver::solve): the fixed point `s <- mu ||u_t(gamma(s))||` with the IPM
 /// solving each convex problem to a share of the tolerance, warm started from the previous
 /// outer iterate; the outer iterate with the lowest Coulomb residual is returned. The fixed
-/// point converges where NSGS stalls on some crowded problems and creeps where a sliding
-/// contact is held open or closed by the others (its shift then moves by that contact's normal
-/// velocity in every outer iteration); see coulomb_stall_probe.
+/// point converges on some crowded problems where NSGS stalls, and creeps where a sliding
+/// contact's normal velocity is held away from zero by the others (its shift then moves by that
+/// velocity in every outer iteration); the reference world alternates it with NSGS
+/// (reference::Settings::ipm_rounds). See demos/bench/coulomb_stall_probe.cpp.
 ///
 /// Contacts with mu = 0 are not supported (Status::InvalidInput naming the contact).
 /// Residuals are those of solver.hpp (Result::residual, Result::coulomb_distance).

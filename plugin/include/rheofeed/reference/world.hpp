@@ -166,9 +166,10 @@ struct Settings {
   /// NSGS again, each starting from the best iterate so far, until one converges; the iterate
   /// with the lowest Coulomb residual is applied (StepReport::ipm_rounds). The IPM's iterations
   /// do not depend on N's conditioning, the sweeps' do; NSGS then finishes what the fixed point
-  /// leaves creeping. On the main demo's first 5 s this converges 446 of 485 steps where NSGS
-  /// alone converges 254 (demos/results/reference_judges.md). Not for problems above
-  /// ipm_max_contacts, nor with a contact of mu = 0 (the IPM refuses it; NSGS's iterate stays).
+  /// leaves creeping. On the main demo's first 5 s this converges 468 of 485 steps where NSGS
+  /// alone converges 254, at 1.5 times its CPU (demos/results/reference_judges.md). Not for
+  /// problems above ipm_max_contacts, nor with a contact of mu = 0 (the IPM refuses it; NSGS's
+  /// iterate stays).
   int ipm_rounds = 2;
   /// Largest contact count (>= 0) for ipm_rounds.
   int ipm_max_contacts = 1000;
