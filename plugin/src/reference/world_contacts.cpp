@@ -197,9 +197,16 @@ void solveStage(StepContext& c) {
       ipm = cfg.ipm;
       ipm.tolerance = cfg.solver.tolerance;
       ipm.residual_rho = cfg.solver.residual_rho;
-      ipm.time_limit_s = cfg.solver.time_limit_s;
       ipm.warm_start = true;
+      // The step's time limit (if any) covers all the solves: each gets what is left of it.
+      const double limit = cfg.solver.time_limit_s;
+      ipm.time_limit_s = limit;
       auto attempt = [&](auto& solver) {
+        if (limit > 0.0) {
+          const double left = limit - report.solve.solve_time_s;
+          if (left <= 0.0) return ccp::Status::InvalidInput;  // no time left: stop the rounds
+          solver.settings().time_limit_s = left;
+        }
         s.ipm_gamma = gamma;
         const ccp::Result next = solver.solve(s.problem, s.ipm_gamma);
         const double earlier = report.solve.solve_time_s;
@@ -214,7 +221,8 @@ void solveStage(StepContext& c) {
       for (int round = 0;
            round < cfg.ipm_rounds && report.solve.status == ccp::Status::MaxIterations; ++round) {
         ++report.ipm_rounds;
-        if (attempt(s.ipm) == ccp::Status::InvalidInput) break;  // e.g. a contact with mu = 0
+        // InvalidInput: refused (a contact with mu = 0) or no time left.
+        if (attempt(s.ipm) == ccp::Status::InvalidInput) break;
         if (report.solve.status != ccp::Status::MaxIterations) break;
         attempt(s.nsgs);
       }
