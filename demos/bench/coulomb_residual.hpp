@@ -19,4 +19,8 @@ namespace rheofeed::bench {
 double coulombResidual(const ccp::Problem& p, const Eigen::VectorXd& gamma,
                        const Eigen::VectorXd* shift = nullptr);
 
+// The squared per-contact terms of coulombResidual's numerator ((m/s)^2, nc values).
+Eigen::VectorXd coulombErrors(const ccp::Problem& p, const Eigen::VectorXd& gamma,
+                              const Eigen::VectorXd* shift = nullptr);
+
 }  // namespace rheofeed::bench

@@ -22,7 +22,6 @@
 
 #include <Eigen/Core>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -44,34 +43,22 @@ using Eigen::Vector3d;
 using Eigen::VectorXd;
 using rheofeed::bench::coulombResidual;
 
-double seconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
 // The contact that holds most of the Coulomb residual at `gamma`: its share and state.
 std::string worstContact(const ccp::Problem& p, const VectorXd& gamma) {
-  const VectorXd u = p.contactVelocity(gamma);
+  const VectorXd errors = rheofeed::bench::coulombErrors(p, gamma);
   Eigen::Index worst = 0;
-  double worst_error = -1, total = 0;
-  for (Eigen::Index i = 0; i < p.numContacts(); ++i) {
-    const double step = 3.0 / p.diagonalBlock(i).trace();
-    Vector3d v = u.segment<3>(3 * i);
-    v[0] += p.mu[i] * std::hypot(v[1], v[2]);
-    const Vector3d g = gamma.segment<3>(3 * i);
-    const double e = ((g - ccp::projectOntoCone(g - step * v, p.mu[i])) / step).squaredNorm();
-    total += e;
-    if (e > worst_error) worst_error = e, worst = i;
-  }
+  errors.maxCoeff(&worst);
+  const VectorXd u = p.contactVelocity(gamma);
+  const Vector3d g = gamma.segment<3>(3 * worst);
   std::ostringstream s;
   s.precision(3);
-  const double ut = std::hypot(u[3 * worst + 1], u[3 * worst + 2]);
-  const double gt = std::hypot(gamma[3 * worst + 1], gamma[3 * worst + 2]);
-  s << "contact " << worst << " (" << 100 * worst_error / total << " % of the squared residual): "
-    << (gamma[3 * worst] <= 0                              ? "open"
-        : gt < (1 - 1e-6) * p.mu[worst] * gamma[3 * worst] ? "stick"
-                                                           : "slide")
-    << ", u_n " << u[3 * worst] << " m/s, |u_t| " << ut << " m/s, gamma_n " << gamma[3 * worst]
-    << " N s";
+  s << "contact " << worst << " (" << 100 * errors[worst] / errors.sum()
+    << " % of the squared residual): "
+    << (g[0] <= 0                                                  ? "open"
+        : std::hypot(g[1], g[2]) < (1 - 1e-6) * p.mu[worst] * g[0] ? "stick"
+                                                                   : "slide")
+    << ", u_n " << u[3 * worst] << " m/s, |u_t| " << std::hypot(u[3 * worst + 1], u[3 * worst + 2])
+    << " m/s, gamma_n " << g[0] << " N s";
   return s.str();
 }
 
@@ -104,9 +91,8 @@ Probe probe(const std::string& file, double tol, int max_outer, double mu_scale,
     settings.tolerance = tol;
     ccp::NsgsSolver nsgs(settings);
     VectorXd gamma = VectorXd::Zero(p.size());
-    const auto start = std::chrono::steady_clock::now();
     const ccp::Result result = nsgs.solve(p, gamma);
-    out.nsgs_s = seconds(start);
+    out.nsgs_s = result.solve_time_s;
     out.nsgs_sweeps = result.iterations;
     out.nsgs_residual = coulombResidual(p, gamma);
   }

@@ -113,9 +113,8 @@ std::string IpmSettings::validate() const {
 struct IpmSolver::Workspace {
   detail::Workspace base;  // lambda (residual scales), u, map, dof_a / dof_b
   Eigen::VectorXd scale;   // S as a vector: (1 / mu, 1, 1) per contact
-  Eigen::VectorXd x, z, gamma, r_shifted, rd, dx, dz, rc, d, rhs, y, hy, best, shift;
+  Eigen::VectorXd x, z, gamma, r_shifted, rd, dx, dz, rc, d, rhs, y, hy, sy, best, shift;
   std::vector<NtScaling> nt;
-  bool started = false;  // x and z hold an iterate
   // Dense N.
   Eigen::MatrixXd p;  // S N S
   Eigen::MatrixXd h;
@@ -188,10 +187,9 @@ struct IpmRun {
     w.scale.resize(n);
     for (Eigen::Index i = 0; i < nc; ++i) w.scale.segment<3>(3 * i) << 1.0 / problem.mu[i], 1, 1;
     for (Eigen::VectorXd* v : {&w.x, &w.z, &w.gamma, &w.r_shifted, &w.rd, &w.dx, &w.dz, &w.rc, &w.d,
-                               &w.rhs, &w.y, &w.hy, &w.best})
+                               &w.rhs, &w.y, &w.hy, &w.sy, &w.best})
       v->resize(n);
     w.nt.resize(static_cast<std::size_t>(nc));
-    w.started = false;
     w.analysed = false;
     if (problem.form == DelassusForm::Dense) {
       w.p = w.scale.asDiagonal() * problem.delassus * w.scale.asDiagonal();
@@ -222,7 +220,6 @@ struct IpmRun {
       w.x[3 * i] = g0;
       w.z[3 * i] = z0;
     }
-    w.started = true;
   }
 
   // Steps a previous solution back into the interior (warm start of the next convex solve).
@@ -235,10 +232,23 @@ struct IpmRun {
     }
   }
 
+  // w.base.u = N gamma + r (m/s).
+  void velocity(const Eigen::VectorXd& gamma, const Eigen::VectorXd& r) {
+    detail::multiplyDelassus(problem, gamma, w.base.u, w.base);
+    w.base.u += r;
+  }
+
+  // De Saxce's shift s_i = mu_i ||u_t,i|| of the velocities in w.base.u.
+  void updateShift() {
+    for (Eigen::Index i = 0; i < nc; ++i) {
+      w.shift[i] = problem.mu[i] * detail::tangentialNorm(w.base.u.segment<3>(3 * i));
+    }
+  }
+
   // w.hy = (P + W^-2) y.
   void multiplyNewton(const Eigen::VectorXd& y) {
-    w.gamma = w.scale.cwiseProduct(y);
-    detail::multiplyDelassus(problem, w.gamma, w.hy, w.base);
+    w.sy = w.scale.cwiseProduct(y);  // not w.gamma: that is S x, which the caller reads
+    detail::multiplyDelassus(problem, w.sy, w.hy, w.base);
     w.hy = w.scale.cwiseProduct(w.hy);
     for (Eigen::Index i = 0; i < nc; ++i) {
       const Eigen::Matrix3d& wi = w.nt[static_cast<std::size_t>(i)].w_inv;
@@ -348,8 +358,7 @@ struct IpmRun {
   // Convex residual of the current iterate with offsets w.shift (also leaves w.gamma, w.base.u).
   double convexResidual() {
     w.gamma = w.scale.cwiseProduct(w.x);
-    detail::multiplyDelassus(problem, w.gamma, w.base.u, w.base);
-    w.base.u += w.r_shifted;
+    velocity(w.gamma, w.r_shifted);
     return detail::relativeResidual(w.gamma, w.base.u, w.r_shifted, problem.mu,
                                     settings.residual_rho, false, w.base);
   }
@@ -486,11 +495,8 @@ Result IpmSolver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
     detail::projectOntoCones(gamma, problem.mu);
     w.shift.setZero(nc);
     if (warm) {
-      detail::multiplyDelassus(problem, gamma, w.base.u, w.base);
-      w.base.u += problem.r;
-      for (Eigen::Index i = 0; i < nc; ++i) {
-        w.shift[i] = problem.mu[i] * detail::tangentialNorm(w.base.u.segment<3>(3 * i));
-      }
+      run.velocity(gamma, problem.r);
+      run.updateShift();
     }
     w.best = gamma;
     double best = std::numeric_limits<double>::infinity();
@@ -508,8 +514,7 @@ Result IpmSolver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
         break;
       }
       // w.gamma is S x; the Coulomb residual of it with De Saxce's velocity.
-      detail::multiplyDelassus(problem, w.gamma, w.base.u, w.base);
-      w.base.u += problem.r;
+      run.velocity(w.gamma, problem.r);
       const double coulomb = detail::relativeResidual(w.gamma, w.base.u, problem.r, problem.mu,
                                                       settings_.residual_rho, true, w.base);
       if (coulomb < best) {
@@ -521,9 +526,7 @@ Result IpmSolver::solve(const Problem& problem, Eigen::VectorXd& gamma) {
         break;
       }
       if (out.timed_out || deadline.expired()) break;
-      for (Eigen::Index i = 0; i < nc; ++i) {
-        w.shift[i] = problem.mu[i] * detail::tangentialNorm(w.base.u.segment<3>(3 * i));
-      }
+      run.updateShift();
     }
     gamma = w.best;
   }

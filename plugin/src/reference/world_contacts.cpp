@@ -173,6 +173,49 @@ void warmStartStage(StepContext& c) {
   s.warm_claimed.clear();
 }
 
+// Settings::ipm_rounds after an unconverged NSGS solve: the interior-point fixed point and NSGS
+// in turn, each from the best iterate so far, until one converges; the lower Coulomb residual
+// is kept. The step's time limit (if any) covers all the solves: each gets what is left of it.
+void alternateWithIpm(StepContext& c) {
+  WorldState& s = c.s;
+  const Settings& cfg = c.cfg;
+  StepReport& report = c.report;
+  ccp::IpmSettings& ipm = s.ipm.settings();
+  ipm = cfg.ipm;
+  ipm.tolerance = cfg.solver.tolerance;
+  ipm.residual_rho = cfg.solver.residual_rho;
+  const double limit = cfg.solver.time_limit_s;
+  ipm.time_limit_s = limit;
+  // One solve from c.gamma; false when the rounds must end (no time left, or a refusal).
+  auto attempt = [&](auto& solver) {
+    if (limit > 0.0) {
+      const double left = limit - report.solve.solve_time_s;
+      if (left <= 0.0) return false;
+      solver.settings().time_limit_s = left;
+    }
+    s.trial_gamma = c.gamma;
+    const ccp::Result next = solver.solve(s.problem, s.trial_gamma);
+    if (next.status == ccp::Status::InvalidInput) {
+      report.ipm_not_run = next.message;
+      return false;
+    }
+    const double earlier = report.solve.solve_time_s;
+    if (next.status != ccp::Status::NumericalIssue &&
+        next.coulomb_distance < report.solve.coulomb_distance) {
+      report.solve = next;
+      c.gamma = s.trial_gamma;
+    }
+    report.solve.solve_time_s = earlier + next.solve_time_s;
+    return true;
+  };
+  for (int round = 0; round < cfg.ipm_rounds; ++round) {
+    if (!attempt(s.ipm)) return;
+    ++report.ipm_rounds;
+    if (report.solve.status != ccp::Status::MaxIterations || !attempt(s.nsgs)) return;
+    if (report.solve.status != ccp::Status::MaxIterations) return;
+  }
+}
+
 // The contact solve, its fallback flags and the guard against non-finite impulses. Writes
 // c.report.solve, coulomb_fallback, coulomb_residual and c.gamma.
 void solveStage(StepContext& c) {
@@ -192,39 +235,13 @@ void solveStage(StepContext& c) {
     report.solve = s.nsgs.solve(s.problem, gamma);
     // Alternate with the interior-point fixed point while unconverged: each solver starts from
     // the best iterate so far and the lower Coulomb residual is kept (Settings::ipm_rounds).
-    if (report.solve.status == ccp::Status::MaxIterations && c.nc <= cfg.ipm_max_contacts) {
-      ccp::IpmSettings& ipm = s.ipm.settings();
-      ipm = cfg.ipm;
-      ipm.tolerance = cfg.solver.tolerance;
-      ipm.residual_rho = cfg.solver.residual_rho;
-      ipm.warm_start = true;
-      // The step's time limit (if any) covers all the solves: each gets what is left of it.
-      const double limit = cfg.solver.time_limit_s;
-      ipm.time_limit_s = limit;
-      auto attempt = [&](auto& solver) {
-        if (limit > 0.0) {
-          const double left = limit - report.solve.solve_time_s;
-          if (left <= 0.0) return ccp::Status::InvalidInput;  // no time left: stop the rounds
-          solver.settings().time_limit_s = left;
-        }
-        s.ipm_gamma = gamma;
-        const ccp::Result next = solver.solve(s.problem, s.ipm_gamma);
-        const double earlier = report.solve.solve_time_s;
-        if ((next.status == ccp::Status::Converged || next.status == ccp::Status::MaxIterations) &&
-            next.coulomb_distance < report.solve.coulomb_distance) {
-          report.solve = next;
-          gamma = s.ipm_gamma;
-        }
-        report.solve.solve_time_s = earlier + next.solve_time_s;
-        return next.status;
-      };
-      for (int round = 0;
-           round < cfg.ipm_rounds && report.solve.status == ccp::Status::MaxIterations; ++round) {
-        ++report.ipm_rounds;
-        // InvalidInput: refused (a contact with mu = 0) or no time left.
-        if (attempt(s.ipm) == ccp::Status::InvalidInput) break;
-        if (report.solve.status != ccp::Status::MaxIterations) break;
-        attempt(s.nsgs);
+    // Where the rounds cannot run, the step says why (StepReport::ipm_not_run).
+    if (report.solve.status == ccp::Status::MaxIterations && cfg.ipm_rounds > 0) {
+      if (c.nc > cfg.ipm_max_contacts) {
+        report.ipm_not_run = std::to_string(c.nc) + " contacts, above ipm_max_contacts = " +
+                             std::to_string(cfg.ipm_max_contacts);
+      } else {
+        alternateWithIpm(c);
       }
     }
     report.coulomb_residual = report.solve.coulomb_distance;

@@ -143,7 +143,7 @@ struct WorldState {
   ccp::Solver solver;
   ccp::NsgsSolver nsgs;
   ccp::IpmSolver ipm;
-  Eigen::VectorXd ipm_gamma;
+  Eigen::VectorXd trial_gamma;  // the impulses of a solve of Settings::ipm_rounds
   std::vector<RawContact> raw;
   std::vector<ContactImpulse> contacts;
   // Last step's contacts per geom pair (dCollide's order): point and impulse on g1's body, both

@@ -113,6 +113,13 @@ class ReferenceSimulation final : public PartSimulation {
       ++health_.ipm_second_solve_steps;
       if (report.solve.status == ccp::Status::Converged) ++health_.ipm_converged_steps;
     }
+    if (!report.ipm_not_run.empty()) {
+      ++health_.ipm_not_run_steps;
+      std::ostringstream line;
+      line << "step from t = " << time() << " s: NSGS ended unconverged and the interior-point "
+           << "rounds did not run: " << report.ipm_not_run;
+      reportFirst("step without interior-point rounds", line.str());
+    }
     if (report.contacts > 0 && report.solve.status != ccp::Status::Converged) {
       ++health_.solver_unconverged_steps;
       std::ostringstream line;

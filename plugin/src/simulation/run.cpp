@@ -114,6 +114,10 @@ std::string healthSummary(const RunHealth& h, int parts) {
         << "the interior-point fixed point and NSGS in turn, " << h.ipm_converged_steps
         << " of them converged)";
     }
+    if (h.ipm_not_run_steps > 0) {
+      s << " (" << h.ipm_not_run_steps << " of them without the interior-point rounds: too "
+        << "many contacts or refused)";
+    }
     separator = "; ";
   }
   if (h.friction_dropped_contacts > 0) {

@@ -169,12 +169,13 @@ struct Settings {
   /// leaves creeping. On the main demo's first 5 s this converges 468 of 485 steps where NSGS
   /// alone converges 254, at 1.5 times its CPU (demos/results/reference_judges.md). Not for
   /// problems above ipm_max_contacts, nor with a contact of mu = 0 (the IPM refuses it; NSGS's
-  /// iterate stays).
+  /// iterate stays); both are said (StepReport::ipm_not_run).
   int ipm_rounds = 2;
   /// Largest contact count (>= 0) for ipm_rounds.
   int ipm_max_contacts = 1000;
-  /// Settings of the second solve. Its tolerance, residual_rho and time limit are taken from
-  /// `solver` as NSGS's are; the rest as given.
+  /// Settings of the interior-point solves. Their tolerance, residual_rho and time limit are
+  /// taken from `solver` as NSGS's are (the time limit covering all of a step's solves); the
+  /// rest as given.
   ccp::IpmSettings ipm;
   /// Use the dense Delassus matrix up to this many contacts, matrix-free above.
   int dense_contact_limit = 100;
@@ -220,6 +221,10 @@ struct StepReport {
   /// ended unconverged (0: none). `solve` is then the result of the solve whose iterate was
   /// applied, with solve_time_s covering all of them.
   int ipm_rounds = 0;
+  /// Why Settings::ipm_rounds did not run (or stopped) on a step NSGS left unconverged: more
+  /// contacts than ipm_max_contacts, or the interior-point method's refusal (a contact with
+  /// mu = 0). Empty otherwise.
+  std::string ipm_not_run;
   /// Dynamic bodies whose implicit-midpoint gyroscopic solve did not converge this step (only
   /// for h |w| far beyond 1); they got one dissipative implicit-Euler Newton step instead.
   int gyroscopic_fallbacks = 0;

@@ -116,6 +116,9 @@ struct RunHealth {
   /// those of them that then converged (they are not in solver_unconverged_steps).
   long ipm_second_solve_steps = 0;
   long ipm_converged_steps = 0;
+  /// ... and steps NSGS left unconverged on which those rounds could not run
+  /// (StepReport::ipm_not_run: too many contacts, or refused by the interior-point method).
+  long ipm_not_run_steps = 0;
   /// Reference engine: contacts whose friction the Coulomb fallback had to drop to end its
   /// normal re-solve (StepReport's solve.friction_dropped_contacts), and steps in which a
   /// body's implicit gyroscopic solve did not converge and took a dissipative step instead.
