@@ -55,7 +55,7 @@ constexpr double kTurns = 2;
 constexpr double kTrackTilt = 3 * kDeg;       // the ramp's top falls towards the wall
 constexpr int kTrackSegments = 64;            // per turn
 constexpr double kWiperAzimuth = 300 * kDeg;  // on the last turn
-constexpr double kWiperClearance = 0.0065;    // above the track at the wiper's downstream end
+constexpr double kWiperClearance = 0.0065;    // above the track, along the whole blade
 constexpr double kWiperAngle = 35 * kDeg;     // to the track direction
 constexpr double kOutletLength = 0.125;       // straight outlet track, tangent at azimuth 0
 constexpr double kOutletWallTop = 0.064;      // the wall is cut down to this where it exits
@@ -173,20 +173,31 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
     // Wiper: a blade across the last turn, kWiperClearance above the track, running from the
     // wall forwards and inwards at kWiperAngle. Nuts lying flat (5 mm) pass under it; nuts on
     // edge (9-11 mm) or riding on another nut hit it, slide along it and fall off the track's
-    // inner edge back into the bowl.
+    // inner edge back into the bowl. Its bottom follows the track's top (which rises along the
+    // helix and falls towards the wall, about 3 mm over the blade's length): a level blade had
+    // 9.5 mm of clearance at the wall, and a 9 mm cube slid along it and under it where its top
+    // overlapped the blade by 1 mm. Its outer end lies in the wall: the end face (square to the
+    // blade) reaches 1 mm into the wall at both its corners.
+    const double blade_height = 0.020, blade_thickness = 0.012;
     const double phi0 = 2 * kPi + kWiperAzimuth;
-    const double r0 = kInnerRadius + 0.002, r1 = kInnerRadius - kTrackWidth - 0.004;
+    const double r0 = kInnerRadius + 0.001 + 0.5 * blade_thickness * std::cos(kWiperAngle),
+                 r1 = kInnerRadius - kTrackWidth - 0.004;
     const double along = (r0 - r1) / std::tan(kWiperAngle);
     const double phi1 = phi0 + along / trackCentre();
-    const Vec3 p0{r0 * std::cos(phi0), r0 * std::sin(phi0), 0};
-    const Vec3 p1{r1 * std::cos(phi1), r1 * std::sin(phi1), 0};
-    const Vec3 d = p1 - p0;
-    const double blade_height = 0.020, blade_thickness = 0.012;
-    const double bottom = trackTop(phi1) + kWiperClearance;
+    // The track's top at radius r, azimuth phi (it falls outwards at kTrackTilt).
+    const auto top_at = [](double r, double phi) {
+      return trackTop(phi) - std::tan(kTrackTilt) * (r - trackCentre());
+    };
+    const Vec3 p0{r0 * std::cos(phi0), r0 * std::sin(phi0), top_at(r0, phi0) + kWiperClearance};
+    const Vec3 p1{r1 * std::cos(phi1), r1 * std::sin(phi1), top_at(r1, phi1) + kWiperClearance};
+    const Vec3 d = p1 - p0;  // along the blade's bottom edge
+    const double level = std::hypot(d.x, d.y);
+    const Pose yaw = Pose::axisAngle({0, 0, 1}, std::atan2(d.y, d.x));
+    const Pose pitch = Pose::axisAngle({0, 1, 0}, -std::atan2(d.z, level));
+    const Pose blade = composed(yaw, pitch, Vec3{});
     bowl.geoms.push_back(
         box({norm(d), blade_thickness, blade_height},
-            Pose::axisAngle({0, 0, 1}, std::atan2(d.y, d.x),
-                            0.5 * (p0 + p1) + Vec3{0, 0, bottom + 0.5 * blade_height})));
+            composed(yaw, pitch, 0.5 * (p0 + p1) + blade.rotate({0, 0, 0.5 * blade_height}))));
 
     // Return chute: a plate under the wiper's drop zone, from just below the ramp's inner
     // edge down inwards at 35 degrees (> atan(mu), so nuts slide) to the cone. A wiped nut

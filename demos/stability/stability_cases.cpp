@@ -500,6 +500,12 @@ StabilityCase turntableCase(double omega, bool rim, double duration) {
                     " m: parts fly off the table (lost, must be reported)";
     b.kase().expect_losses = true;
   }
+  if (rim && omega * omega * 0.29 > 50 * kG) {
+    b.kase().note = "w^2 r = " + formatNumber(omega * omega * 0.29 / kG) +
+                    " g at the rim: the boxes tumble against the 6 cm rim and some are thrown "
+                    "over it (lost, must be reported; the reference engine loses one the same way)";
+    b.kase().expect_losses = true;
+  }
   return b.finish();
 }
 

@@ -157,7 +157,9 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
   }
   dBodyID b1 = dGeomGetBody(o1);
   dBodyID b2 = dGeomGetBody(o2);
-  if (!b1 && !b2) return;  // two static geoms: nothing to constrain
+  // Two static or kinematic geoms (a vibrating fixture touching a static one in a full-vibration
+  // run): nothing to constrain.
+  if ((!b1 || dBodyIsKinematic(b1)) && (!b2 || dBodyIsKinematic(b2))) return;
   if (settings_.skip_connected_bodies && b1 && b2 &&
       dAreConnectedExcluding(b1, b2, dJointTypeContact)) {
     return;

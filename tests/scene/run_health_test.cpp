@@ -164,6 +164,46 @@ TEST(RunHealth, CubePushedOutThroughTheFloorsUndersideIsCountedThroughFixture) {
   }
 }
 
+// The same throw 5 mm from the edge of a thick floor (its +x face at x = 3 mm, the cube's
+// centre at x = 0): after the step the cube overlaps the floor by 8 mm across that face and by
+// 12.5 mm across the top, so contact pushes it out sideways. In through the top, out through
+// the side: a corner cut, sunk and not through (its centre never went past the floor's far
+// side). Every count is also an event in RunHealth::part_events, naming the fixture.
+TEST(RunHealth, CubeSunkAtAFloorsEdgeAndPushedOutSidewaysIsSunkNotThrough) {
+  const double z1 = kStartHeight - kStep * (kThrowSpeed + kGravity * kStep);
+  const double thickness = 0.05, edge_x = 0.003;
+  const double side_overlap = edge_x + 0.5 * kEdge, top_overlap = 0.5 * kEdge - z1;
+  ASSERT_LT(side_overlap, top_overlap);
+  Scene s = thickFloorScene(thickness);
+  s.fixtures[0] = test::boxFixture("floor", {1, 1, thickness}, {edge_x - 0.5, 0, -0.5 * thickness});
+  for (Method m : kRheonomic) {
+    SCOPED_TRACE(toString(m));
+    const std::unique_ptr<Simulation> sim = runFor(s, m, 30);
+    const RunHealth& h = sim->health();
+    EXPECT_GT(sim->part(0).position.x, edge_x);  // out on the +x side
+    EXPECT_EQ(h.parts_through_fixture, 0);
+    EXPECT_EQ(h.parts_sunk, 1);
+    ASSERT_EQ(h.part_events.size(), 1u);
+    EXPECT_EQ(h.part_events[0].kind, "sunk");
+    EXPECT_EQ(h.part_events[0].fixture, "floor");
+    EXPECT_EQ(h.part_events[0].part, 0);
+    EXPECT_NE(h.part_events[0].what.find("corner cut"), std::string::npos) << h.part_events[0].what;
+  }
+}
+
+TEST(RunHealth, EveryCountedPartIsAnEventWithTheRunsCount) {
+  // The thin floor's tunnelled cube: one event, through the floor, at the step's time.
+  const std::unique_ptr<Simulation> sim =
+      runFor(thinFloorScene(kStartHeight, kThrowSpeed), Method::OdeRheonomic, 1);
+  const RunHealth& h = sim->health();
+  ASSERT_EQ(h.part_events.size(), 1u);
+  EXPECT_EQ(h.part_events[0].kind, "through_fixture");
+  EXPECT_EQ(h.part_events[0].fixture, "floor");
+  EXPECT_DOUBLE_EQ(h.part_events[0].time, kStep);
+  EXPECT_DOUBLE_EQ(h.part_events[0].position.z, sim->part(0).position.z);
+  EXPECT_EQ(h.part_events_dropped, 0);
+}
+
 // ---- Falls, bounds, exits -----------------------------------------------------------------
 
 // A frictionless 20 cm square floor (top z = 0); a 2 cm cube on it 5 cm from its +x edge,

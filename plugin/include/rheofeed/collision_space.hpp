@@ -22,6 +22,13 @@
 /// cheaper at 2000 parts) and its losses were not distinguishable from the hash space's (35
 /// against 24 parts through a fixture in 8 runs; demos/results/crowd_leaks.md, section 6).
 /// Scenes choose with solver.broad_phase.
+///
+/// The hash space is made with cell levels kHashSpaceMinLevel..kHashSpaceMaxLevel (cells of
+/// 2^level m, 1/1024 m to 1024 m) instead of ODE's default -3..10: ODE files a geom at the
+/// level whose cell covers its bounding box but never below the minimum, so with the default
+/// every part smaller than 125 mm shares 125 mm cells with dozens of others in a heap and every
+/// pair in a cell is tested. On the main demo's trough at 1000 parts the finer levels took a
+/// third off the collision stage (crowd_leaks.md, section 9).
 #pragma once
 
 #include <ode/ode.h>
@@ -38,6 +45,11 @@ inline bool odeHashSpaceIsSound() {
   return sound;
 }
 
+/// The hash space's cell levels (cell edge 2^level m): parts down to about 1 mm get cells of
+/// their own size; geoms larger than 1024 m (and planes) go to ODE's list of large geoms.
+inline constexpr int kHashSpaceMinLevel = -10;
+inline constexpr int kHashSpaceMaxLevel = 10;
+
 /// A broad phase createCollisionSpace can be asked for.
 enum class BroadPhase {
   Hash,           ///< dHashSpaceCreate: only where odeHashSpaceIsSound()
@@ -49,7 +61,8 @@ inline const char* toString(BroadPhase broad_phase) {
 }
 
 /// A new top-level (parent null) or child space that pairs every overlapping pair of geoms:
-/// the one of `broad_phase`, or when it is unset dHashSpaceCreate(parent) where
+/// the one of `broad_phase`, or when it is unset dHashSpaceCreate(parent) (levels
+/// kHashSpaceMinLevel..kHashSpaceMaxLevel) where
 /// odeHashSpaceIsSound() and dSweepAndPruneSpaceCreate(parent, dSAP_AXES_XYZ) elsewhere.
 /// Throws std::invalid_argument for BroadPhase::Hash on an ODE whose hash space misses pairs
 /// (no patches/0004): it would let parts through fixtures. Destroy it with dSpaceDestroy.
@@ -66,7 +79,9 @@ inline dSpaceID createCollisionSpace(dSpaceID parent,
         "broad phase hash: the linked ODE's hash space misses pairs (it lacks rheofeed's "
         "patches/0004-hash-space-cell-slots); use sweep_and_prune");
   }
-  return dHashSpaceCreate(parent);
+  dSpaceID space = dHashSpaceCreate(parent);
+  dHashSpaceSetLevels(space, kHashSpaceMinLevel, kHashSpaceMaxLevel);
+  return space;
 }
 
 /// The broad phase of a space createCollisionSpace made (for reporting).

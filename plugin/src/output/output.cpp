@@ -65,13 +65,12 @@ std::string jsonQuoted(const std::string& text) {
   return out + "\"";
 }
 
-namespace {
-
-// A number for JSON: %.8g, null when not finite.
 std::string jsonNumber(double x) {
   if (!std::isfinite(x)) return "null";
   return formatNumber(x, 8);
 }
+
+namespace {
 
 // The JSON keys of the families: the name, or "name[k]" when an earlier family has that name.
 std::vector<std::string> familyKeys(const FeederMetrics& f) {

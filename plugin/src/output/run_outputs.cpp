@@ -71,6 +71,18 @@ std::string summaryJson(const RunMetrics& r) {
   for (std::size_t k = 0; k < h.ignored_settings.size(); ++k) {
     json += (k ? ", " : "") + jsonQuoted(h.ignored_settings[k]);
   }
+  json += "], \"part_events_dropped\": " + std::to_string(h.part_events_dropped) +
+          ", \"part_events\": [";
+  for (std::size_t k = 0; k < h.part_events.size(); ++k) {
+    const PartEvent& e = h.part_events[k];
+    const auto vec = [](const Vec3& v) {
+      return "[" + jsonNumber(v.x) + ", " + jsonNumber(v.y) + ", " + jsonNumber(v.z) + "]";
+    };
+    json += std::string(k ? ", " : "") + "{\"part\": " + std::to_string(e.part) +
+            ", \"kind\": " + jsonQuoted(e.kind) + ", \"t_s\": " + jsonNumber(e.time) +
+            ", \"position_m\": " + vec(e.position) + ", \"velocity_mps\": " + vec(e.velocity) +
+            ", \"fixture\": " + jsonQuoted(e.fixture) + ", \"what\": " + jsonQuoted(e.what) + "}";
+  }
   json += "]}, \"scene_check\": [";
   for (std::size_t k = 0; k < r.scene_check.size(); ++k) {
     json += (k ? ", " : "") + jsonQuoted(r.scene_check[k]);

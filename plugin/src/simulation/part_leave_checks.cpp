@@ -117,7 +117,7 @@ void PartSimulation::checkPhysicalSpeed(std::size_t i, const PartState& s) {
        << "fastest "
        << "surface " << limits_.surface_speed << " m/s + push-out " << limits_.correcting_speed
        << " m/s] + " << kPhysicalSpeedMargin << " m/s; kept)";
-  countLoss(i, "too-fast part", what.str(), health_.parts_too_fast, s);
+  countLoss(i, "too_fast", "too-fast part", what.str(), health_.parts_too_fast, s);
 }
 
 }  // namespace rheofeed::scene

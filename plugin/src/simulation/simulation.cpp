@@ -49,9 +49,12 @@
 //   fixture and out again within the step: through (a thin floor jumped over);
 // - else the centre is now inside a fixture (or behind a mesh sheet): the entry point and the
 //   entry surface's outward normal are kept and the part's rays are cast every step until its
-//   centre crosses a surface again: on the outer side of the entry surface's plane is a deep
-//   penetration that recovered (parts_sunk), on its inner side a pass through
-//   (parts_through_fixture); leaving the scene while inside is a pass through too.
+//   centre crosses a surface again: on the outer side of the entry surface's plane, or out
+//   through a surface that does not face away from the entry surface (kThroughCosine: a
+//   corner cut, into a wall's face near its edge and out under it), is a deep penetration that
+//   recovered (parts_sunk); out on the far side is a pass through (parts_through_fixture);
+//   leaving the scene while inside is a pass through too.
+// Every part counted is also recorded (RunHealth::part_events: when, where, which fixture).
 #include "rheofeed/simulation/simulation.hpp"
 
 #include <algorithm>
@@ -59,6 +62,8 @@
 #include <cstdio>
 #include <limits>
 #include <sstream>
+#include <string>
+#include <string_view>
 
 #include "simulation_internal.hpp"
 #include "stage_clock.hpp"
@@ -72,6 +77,10 @@ constexpr double kTunnelCheckFraction = 1e-3;  // of the smallest half-size, see
 // Two crossings along one segment are distinct when they are this far apart (m): far below any
 // part or fixture size, far above the round-off of a ray test over a step.
 constexpr double kCrossingTolerance = 1e-9;
+// A centre that went into a fixture and out again passed through it when the exit surface faces
+// away from the entry surface: their outward normals more than 120 degrees apart (cosine below
+// -kThroughCosine). Out through a face at a right angle to the entry is a corner cut.
+constexpr double kThroughCosine = 0.5;
 
 Bounds emptyBounds() {
   return {{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
@@ -406,7 +415,8 @@ void PartSimulation::spawnDue() {
   }
 }
 
-double PartSimulation::firstCrossing(const Vec3& a, const Vec3& b, Vec3* normal) {
+double PartSimulation::firstCrossing(const Vec3& a, const Vec3& b, Vec3* normal, int* fixture,
+                                     dGeomID* geom) {
   const Vec3 d = b - a;
   const double length = norm(d);
   if (!(length > 0) || fixture_geoms_.empty()) return kInf;
@@ -429,6 +439,8 @@ double PartSimulation::firstCrossing(const Vec3& a, const Vec3& b, Vec3* normal)
     if (dCollide(ray_, g, 1, &contact, sizeof contact) > 0 && contact.depth < first) {
       first = contact.depth;
       if (normal) *normal = {contact.normal[0], contact.normal[1], contact.normal[2]};
+      if (fixture) *fixture = fixture_of_geom_.at(g);
+      if (geom) *geom = g;
     }
   }
   return first;
@@ -471,14 +483,18 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const PartS
   const Vec3 to = s.position;
   const double length = norm(to - from);
   Vec3 normal;
-  const double forward = firstCrossing(from, to, &normal);
+  int fixture = -1;
+  dGeomID geom = nullptr;
+  const double forward = firstCrossing(from, to, &normal, &fixture, &geom);
   if (!(forward <= length)) return;  // no surface crossed
   const Vec3 u = (1.0 / length) * (to - from);
   const char* kind = "part through a fixture";
   if (!tr.inside) {
     const double backward = firstCrossing(to, from);
     if (forward + backward < length - kCrossingTolerance) {  // in and out within the step
-      countLoss(i, kind, "passed through a fixture within one step (tunnelled; kept)",
+      tr.entry_fixture = fixture;
+      countLoss(i, "through_fixture", kind,
+                "passed through a fixture within one step (tunnelled; kept)",
                 health_.parts_through_fixture, s);
       return;
     }
@@ -486,6 +502,8 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const PartS
     tr.outside_point = from;
     tr.entry_point = from + forward * u;
     tr.entry_normal = dot(normal, u) < 0 ? normal : -normal;  // outward: against the motion
+    tr.entry_fixture = fixture;
+    tr.entry_geom = geom;
     return;
   }
   bool unknown = false;
@@ -494,41 +512,82 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const PartS
     // stands on it, say): still inside; the new entry is this crossing.
     tr.entry_point = from + forward * u;
     tr.entry_normal = dot(normal, u) < 0 ? normal : -normal;
+    tr.entry_fixture = fixture;
+    tr.entry_geom = geom;
     return;
   }
   tr.inside = false;
-  if (dot(to - tr.entry_point, tr.entry_normal) > 0) {  // back out on the side it entered
+  const Vec3 exit_normal = dot(normal, u) > 0 ? normal : -normal;  // outward: along the motion
+  // Through: out on the far side, the exit surface facing away from the entry surface. Out on
+  // the side it entered, or on a face beside it (a corner cut: into a wall's face near its
+  // lower edge and out under it, where the flow goes anyway), the part sank and came back.
+  if (dot(to - tr.entry_point, tr.entry_normal) > 0 ||
+      dot(exit_normal, tr.entry_normal) > -kThroughCosine) {
     // ... but it may have travelled inside the fixture past another one (a plate sunk into a
     // belt that slides under a wall standing on it): the straight path from its last centre
-    // outside to this one then crosses that other fixture in and out.
+    // outside to this one then crosses that other geom in and out (crossing the geom it sank
+    // into is the corner cut above).
     const double span = norm(to - tr.outside_point);
-    const double in = firstCrossing(tr.outside_point, to),
+    dGeomID crossed = nullptr;
+    const double in = firstCrossing(tr.outside_point, to, nullptr, nullptr, &crossed),
                  out = firstCrossing(to, tr.outside_point);
-    if (span > 0 && in + out < span - kCrossingTolerance) {
-      countLoss(i, kind, "passed under or through a fixture while sunk into another (kept)",
+    if (span > 0 && in + out < span - kCrossingTolerance && crossed != tr.entry_geom) {
+      countLoss(i, "through_fixture", kind,
+                "passed under or through a fixture while sunk into another (kept)",
                 health_.parts_through_fixture, s);
       return;
     }
     if (!tr.sunk_counted) {
       tr.sunk_counted = true;
       ++health_.parts_sunk;
+      const bool corner = dot(to - tr.entry_point, tr.entry_normal) <= 0;
+      const std::string what = corner ? "went into a fixture and came out on a face beside the "
+                                        "one it entered (a corner cut, deeper than half the part)"
+                                      : "went into a fixture and came back out (a penetration "
+                                        "deeper than half the part)";
+      recordEvent(i, "sunk", what, s);
       std::ostringstream line;
-      line << "part " << i << "'s centre went into a fixture and came back out at t = " << time_
-           << " s, x = " << formatPosition(to) << " (a penetration deeper than half the part)";
+      line << "part " << i << "'s centre " << what << " at t = " << time_
+           << " s, x = " << formatPosition(to);
       reportFirst("part sunk into a fixture", line.str());
     }
     return;
   }
-  countLoss(i, kind, "passed through a fixture over several steps (tunnelled; kept)",
+  countLoss(i, "through_fixture", kind,
+            "passed through a fixture over several steps (tunnelled; kept)",
             health_.parts_through_fixture, s);
 }
 
-void PartSimulation::countLoss(std::size_t i, const std::string& kind, const std::string& what,
-                               int& counter, const PartState& state) {
+void PartSimulation::recordEvent(std::size_t i, const char* key, const std::string& what,
+                                 const PartState& state) {
+  if (health_.part_events.size() >= RunHealth::kMaxPartEvents) {
+    ++health_.part_events_dropped;
+    return;
+  }
+  const Track& tr = tracks_[i];
+  const bool into_fixture =
+      std::string_view(key) == "through_fixture" || std::string_view(key) == "sunk";
+  PartEvent e;
+  e.part = static_cast<int>(i);
+  e.time = time_;
+  e.kind = key;
+  e.what = what;
+  if (into_fixture && tr.entry_fixture >= 0 &&
+      tr.entry_fixture < static_cast<int>(scene_.fixtures.size())) {
+    e.fixture = scene_.fixtures[static_cast<std::size_t>(tr.entry_fixture)].name;
+  }
+  e.position = state.position;
+  e.velocity = state.velocity;
+  health_.part_events.push_back(std::move(e));
+}
+
+void PartSimulation::countLoss(std::size_t i, const char* key, const std::string& kind,
+                               const std::string& what, int& counter, const PartState& state) {
   Track& tr = tracks_[i];
   if (tr.counted) return;
   tr.counted = true;
   ++counter;
+  recordEvent(i, key, what, state);
   std::ostringstream line;
   line << "part " << i << " " << what << " at t = " << time_
        << " s, x = " << formatPosition(state.position) << ", v = " << formatPosition(state.velocity)
@@ -544,32 +603,32 @@ void PartSimulation::remove(std::size_t i, PartCheck check, const PartState& sta
   removePart(static_cast<int>(i), park);
   switch (check) {
     case PartCheck::NonFinite:
-      countLoss(i, "non-finite part", "has a non-finite state (removed)", health_.parts_nonfinite,
-                state);
+      countLoss(i, "nonfinite", "non-finite part", "has a non-finite state (removed)",
+                health_.parts_nonfinite, state);
       return;
     case PartCheck::TooFast: {
       std::ostringstream what;
       what << "moves faster (" << partSpeed(state, tr.radius)
            << " m/s at its fastest point) than the scene's speed bound " << limits_.speed_bound
            << " m/s (removed)";
-      countLoss(i, "too-fast part", what.str(), health_.parts_too_fast, state);
+      countLoss(i, "too_fast", "too-fast part", what.str(), health_.parts_too_fast, state);
       return;
     }
     case PartCheck::BelowRemovalHeight:
     case PartCheck::OutOfBounds:
       if (tr.inside && !tr.beyond_exit) {  // went into a fixture and out of the scene
-        countLoss(i, "part through a fixture",
+        countLoss(i, "through_fixture", "part through a fixture",
                   "passed through a fixture and left the scene (removed)",
                   health_.parts_through_fixture, state);
       } else if (tr.beyond_exit) {
         if (!tr.counted) ++health_.parts_exited;
         tr.counted = true;
       } else if (check == PartCheck::BelowRemovalHeight) {
-        countLoss(i, "fallen part",
+        countLoss(i, "fell", "fallen part",
                   "fell below the removal height without crossing an exit plane (removed)",
                   health_.parts_fell, state);
       } else {
-        countLoss(i, "part out of bounds", "left the scene bounds (removed)",
+        countLoss(i, "out_of_bounds", "part out of bounds", "left the scene bounds (removed)",
                   health_.parts_out_of_bounds, state);
       }
       return;
@@ -623,8 +682,8 @@ void PartSimulation::step() {
     }
     std::string where;
     if (!tr.counted && !tr.beyond_exit && leftFeeder(i, s, where)) {
-      countLoss(i, "part that left the feeder", "left the feeder " + where + " (kept)",
-                health_.parts_left_feeder, s);
+      countLoss(i, "left_feeder", "part that left the feeder",
+                "left the feeder " + where + " (kept)", health_.parts_left_feeder, s);
     }
     if (check != PartCheck::Ok) {
       remove(i, check, s, s);

@@ -99,7 +99,9 @@ class PartSimulation : public Simulation {
     // Centre inside a fixture: where it entered (m) and the entry surface's outward normal.
     bool inside = false;
     Vec3 entry_point, entry_normal;
-    Vec3 outside_point;  // the last centre outside before it went in (m)
+    int entry_fixture = -1;        // the fixture it went into (index in the scene), -1 unknown
+    dGeomID entry_geom = nullptr;  // ... and the geom
+    Vec3 outside_point;            // the last centre outside before it went in (m)
     // Left the feeder (RunHealth): touched a feeder; fixtures that supported it before that;
     // a fixture not among its carriers supported it in the last step.
     bool on_feeder = false;
@@ -120,8 +122,10 @@ class PartSimulation : public Simulation {
   void checkPhysicalSpeed(std::size_t i, const PartState& s);
   // Distance (m) from a along the segment a -> b to the first fixture surface it crosses
   // (ODE ray test at the geoms' current poses); infinity when it crosses none. `normal`
-  // (optional) receives the surface normal there (unit, either orientation).
-  double firstCrossing(const Vec3& a, const Vec3& b, Vec3* normal = nullptr);
+  // (optional) receives the surface normal there (unit, either orientation), `fixture` and
+  // `geom` (optional) the index of the fixture crossed and its geom.
+  double firstCrossing(const Vec3& a, const Vec3& b, Vec3* normal = nullptr, int* fixture = nullptr,
+                       dGeomID* geom = nullptr);
   // Whether point x is inside a fixture geom whose inside ODE can test exactly (box, sphere,
   // capsule, plane: yes/no); `unknown` is set when x lies in the bounding box of a geom it cannot
   // test (cylinder, mesh), where the ray parity of trackCrossings decides instead.
@@ -131,9 +135,12 @@ class PartSimulation : public Simulation {
   // Takes part i out, parked at `park`, and counts it under `check` (unless counted already);
   // `state` is the state that failed the check.
   void remove(std::size_t i, PartCheck check, const PartState& state, const PartState& park);
-  // Counts part i under `counter` unless it was counted already; reports the first of `kind`.
-  void countLoss(std::size_t i, const std::string& kind, const std::string& what, int& counter,
-                 const PartState& state);
+  // Counts part i under `counter` unless it was counted already; reports the first of `kind`
+  // and records the event (RunHealth::part_events) under `key`.
+  void countLoss(std::size_t i, const char* key, const std::string& kind, const std::string& what,
+                 int& counter, const PartState& state);
+  // Appends an event to RunHealth::part_events (or counts it dropped beyond the cap).
+  void recordEvent(std::size_t i, const char* key, const std::string& what, const PartState& state);
 
   const Method method_;
   const std::vector<PartInstance> instances_;

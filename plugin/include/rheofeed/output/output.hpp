@@ -21,6 +21,8 @@ void writeFileAtomically(const std::filesystem::path& path, const std::string& t
 
 /// `text` as a JSON string literal (quotes, backslashes and control characters escaped).
 std::string jsonQuoted(const std::string& text);
+/// `x` as a JSON number (8 significant digits), or null when it is not finite.
+std::string jsonNumber(double x);
 
 /// CSV of the output rate over time, one row per window (RateWindow):
 /// window_start_s,window_end_s,exits,rate_per_min,cumulative_exits.

@@ -32,6 +32,18 @@ struct ContactTotals {
   Vec3 impulse;               ///< sum of impulse vectors on the first geom's body (N s, world)
 };
 
+/// One part counted by RunHealth as lost or sunk: which, when, where and how.
+struct PartEvent {
+  int part = -1;        ///< the part's index (spawn order)
+  double time = 0;      ///< simulated time of the step that found it (s)
+  std::string kind;     ///< the count it went to: "through_fixture", "sunk", "left_feeder",
+                        ///< "fell", "out_of_bounds", "nonfinite" or "too_fast"
+  std::string what;     ///< what happened, as printed on stderr for the first of its kind
+  std::string fixture;  ///< the fixture it went into (through_fixture, sunk), else empty
+  Vec3 position;        ///< its centre then (m, world frame)
+  Vec3 velocity;        ///< its centre's velocity then (m/s, world frame)
+};
+
 /// What a run lost, could not trust or ignored, counted since the start (issue 7: no silent
 /// failure). The first occurrence of each kind is reported on stderr (part, time, position);
 /// measureRun prints the totals and writes them into the run's JSON and CSV outputs.
@@ -73,6 +85,7 @@ struct ContactTotals {
 /// (SolverSettings::max_correcting_velocity). A part above it is counted as too fast and kept;
 /// a part above the scene's blow-up bound SceneLimits::speed_bound is also removed.
 struct RunHealth {
+  static constexpr std::size_t kMaxPartEvents = 1000;
   long steps = 0;  ///< steps taken
   /// Parts removed below Scene::removal_height (or beyond the scene bounds) after being beyond
   /// the exit plane: normal flow.
@@ -162,6 +175,10 @@ struct RunHealth {
   /// the previous step's force of the same contact (summed over steps; 0 when off and for the
   /// reference engine). Informative.
   long warm_started_contacts = 0;
+  /// Every part counted above (lost, sunk), in the order found: the first kMaxPartEvents of the
+  /// run, and how many more there were. Written to the run JSON (health.part_events).
+  std::vector<PartEvent> part_events;
+  long part_events_dropped = 0;
   /// Parts lost in any way but the exit: fell + through_fixture + left_feeder + out_of_bounds +
   /// nonfinite + too_fast, plus those inside a fixture now.
   int partsLost() const {
