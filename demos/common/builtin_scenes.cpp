@@ -207,15 +207,17 @@ Scene linearTroughScene(int count, double rate, double amplitude, double frequen
 
   Fixture hopper;
   hopper.name = "hopper";
-  // Static walls of a square hopper above the trough start, open 60 mm above the floor at the
-  // front and back. The side walls reach 5 mm down into the trough's side walls (z = 0.045 to
-  // 0.21 m): with their bottom at z = 0.06, 10 mm above the trough walls' top, a heap of 1000
-  // or more parts pressed parts (5 mm thick and up) out through that slot and over the trough's
-  // side (demos/results/crowd_leaks.md, section 10).
-  add(hopper, {0.01, 0.12, 0.15}, {-0.09, 0, 0.135});
-  add(hopper, {0.01, 0.12, 0.15}, {0.11, 0, 0.135});
-  add(hopper, {0.2, 0.01, 0.165}, {0.01, 0.065, 0.1275});
-  add(hopper, {0.2, 0.01, 0.165}, {0.01, -0.065, 0.1275});
+  // Static walls of a square hopper above the trough start (inside x = -0.085 .. 0.105 m,
+  // y = -0.06 .. 0.06 m), open 60 mm above the floor at the front and back. The walls are 30 mm
+  // thick, grown outwards from the 10 mm they were: a heap of 1000-2000 parts pressed parts
+  // through the 10 mm front wall near its lower edge. The side walls reach 5 mm down into the
+  // trough's side walls (z = 0.045 to 0.21 m): with their bottom at z = 0.06, 10 mm above the
+  // trough walls' top, the heap pressed parts (5 mm thick and up) out through that slot and over
+  // the trough's side (demos/results/crowd_leaks.md, section 10).
+  add(hopper, {0.03, 0.12, 0.15}, {-0.1, 0, 0.135});
+  add(hopper, {0.03, 0.12, 0.15}, {0.12, 0, 0.135});
+  add(hopper, {0.25, 0.03, 0.165}, {0.01, 0.075, 0.1275});
+  add(hopper, {0.25, 0.03, 0.165}, {0.01, -0.075, 0.1275});
   s.fixtures.push_back(hopper);
 
   Fixture floor;  // catches the parts that leave the trough
