@@ -201,8 +201,8 @@ TEST(SceneCheck, MassRatioFiresWithTheMassesFromDensitiesAndEdges) {
   ASSERT_EQ(m.size(), 1u) << formatHazards(checkScene(s, Method::OdeRheonomic));
   const double light = 1000 * edge * edge * edge, heavy = 1e6 * edge * edge * edge;
   EXPECT_NEAR(m[0].value, heavy / light, kRelative * heavy / light);
-  // the scene's ODE run warm-starts its contacts only if it asks (solver.warm_start)
-  const bool warm = odeWarmStartsContacts(s.solver);
+  // the scene's ODE run warm-starts its contacts by the rule of odeWarmStartsContacts
+  const bool warm = odeWarmStartsContacts(s);
   EXPECT_EQ(m[0].limit, odeQuickstepMassRatioLimit(50, edge, h, kG, warm));
   EXPECT_NE(m[0].safe_setting.find("ode_quickstep = false"), std::string::npos);
   // Dantzig (dWorldStep) solves the LCP exactly: no iteration count to run out of.

@@ -165,14 +165,19 @@ void checkFlushWalls(const CheckContext& c, std::vector<Hazard>& out) {
 
 void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out) {
   const bool quickstep = c.ode && c.scene.solver.ode_quickstep;
-  const bool warm = c.ode && odeWarmStartsContacts(c.scene.solver);
+  const bool warm = c.ode && odeWarmStartsContacts(c.scene);
   if ((quickstep || !c.ode) && c.total_parts >= 2 && c.lightest < kInf && c.heaviest > 0) {
     const double ratio = c.heaviest / c.lightest;
     const int k = c.scene.solver.iterations;
-    // The measured limit of this scene's engine at `iterations` and step h.
+    // The measured limit of this scene's engine at `iterations` and step h (warm starts as the
+    // run at step h would have them: unset, they depend on the step).
+    auto limitWith = [&](int iterations, double h, bool warm_start) {
+      return quickstep
+                 ? odeQuickstepMassRatioLimit(iterations, c.light_thickness, h, c.g, warm_start)
+                 : referenceMassRatioLimit(iterations, c.light_thickness, h, c.g);
+    };
     auto limitAt = [&](int iterations, double h) {
-      return quickstep ? odeQuickstepMassRatioLimit(iterations, c.light_thickness, h, c.g, warm)
-                       : referenceMassRatioLimit(iterations, c.light_thickness, h, c.g);
+      return limitWith(iterations, h, c.ode && odeWarmStartsContacts(c.scene, h));
     };
     const double limit = limitAt(k, c.h);
     if (ratio > limit) {
@@ -217,7 +222,7 @@ void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out) {
       double safe_h = c.h;
       while (!holds(safe_h) && safe_h > 1e-3 * c.h) safe_h *= 0.8;
       if (holds(safe_h)) s << c.step_field << " <= " << fmt(safe_h) << " s, or ";
-      if (warm) s << "solver.warm_start = false, or ";
+      if (warm && ratio <= limitWith(k, c.h, false)) s << "solver.warm_start = false, or ";
       if (quickstep) s << "solver.ode_quickstep = false (Dantzig LCP, exact but slower), or ";
       s << "parts of closer masses";
       hz.safe_setting = s.str();

@@ -79,7 +79,7 @@ class OdeSimulation final : public PartSimulation {
     cs.feedback = true;
     cs.friction = friction;
     cs.speculative = scene.solver.speculative_contacts.value_or(true);
-    cs.warm_start = odeWarmStartsContacts(scene.solver);
+    cs.warm_start = odeWarmStartsContacts(scene);
     collider_ = std::make_unique<ContactCollider>(world_, *feeders_, cs);
     const double mu = scene.material.mu, bounce = scene.material.restitution;
     const int mode =

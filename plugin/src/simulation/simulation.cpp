@@ -65,6 +65,8 @@
 #include <string>
 #include <string_view>
 
+#include "check_internal.hpp"
+#include "rheofeed/contact_collider.hpp"
 #include "simulation_internal.hpp"
 #include "stage_clock.hpp"
 
@@ -729,8 +731,21 @@ FrictionModel odeFrictionModel(const SolverSettings& solver) {
   return *solver.friction;
 }
 
-bool odeWarmStartsContacts(const SolverSettings& solver) {
-  return solver.ode_quickstep && solver.warm_start.value_or(false);
+bool odeWarmStartsContacts(const Scene& scene, double time_step) {
+  const SolverSettings& solver = scene.solver;
+  if (!solver.ode_quickstep) return false;
+  if (solver.warm_start) return *solver.warm_start;
+  if (!odeHasContactWarmStart() || scene.parts.empty()) return false;
+  double thinnest = kInf;
+  for (const PartSpec& p : scene.parts) {
+    thinnest = std::min(thinnest, checks::partRange(p).thinnest);
+  }
+  const double g = norm(scene.gravity), h = time_step;
+  return g > 0 && h > 0 && thinnest / (g * h * h) < kWarmStartMaxX;
+}
+
+bool odeWarmStartsContacts(const Scene& scene) {
+  return odeWarmStartsContacts(scene, scene.solver.time_step);
 }
 
 std::unique_ptr<Simulation> makeSimulation(const Scene& scene, Method method) {

@@ -234,7 +234,8 @@ struct SolverSettings {
   /// ODE runs with quickstep: warm starts (contact_collider.hpp, ContactCollider::Settings::
   /// warm_start): each contact's solve starts from the force the same contact applied in the
   /// previous step, so that a heap's weight is carried over instead of rebuilt from zero by the
-  /// iterations. Unset: off (odeWarmStartsContacts, simulation.hpp, says what it gains and
+  /// iterations. Unset: on for rheonomic steps of small parts (X = e / (|g| h^2) below 50), off
+  /// for fine steps (odeWarmStartsContacts, simulation.hpp, says the rule, what it gains and
   /// costs). Needs rheofeed's patched ODE (patches/0005): true on a stock ODE is refused by the
   /// ODE simulation;
   /// true with ode_quickstep = false (a direct solver) and in the reference engine is an

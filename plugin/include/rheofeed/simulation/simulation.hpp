@@ -352,11 +352,21 @@ std::unique_ptr<Simulation> makeSimulation(const Scene& scene, Method method);
 /// solver.friction for the cone with ode_quickstep = false or on an ODE without the cone.
 FrictionModel odeFrictionModel(const SolverSettings& solver);
 
-/// Whether an ODE run with these settings warm-starts its contacts
-/// (ContactCollider::Settings::warm_start): solver.warm_start with ode_quickstep (dWorldStep has
-/// no use for it). Off unless the scene asks: it halves a heap's drift error at 30 iterations
-/// and lost no part of the main demo, but the mass-ratio probe held stacks of unequal parts up
-/// to 15 times worse with it at some grid points (check_mass_ratio.cpp).
-bool odeWarmStartsContacts(const SolverSettings& solver);
+/// Below this X = e / (|g| h^2) (e the thinnest part's smallest size, m; h the run's step, s) an
+/// ODE quickstep run warm-starts its contacts unless the scene says otherwise: the mass-ratio
+/// probe held stacks of unequal parts as well with warm starts as from zero there, and worse at
+/// some grid points above (demos/results/crowd_leaks.md, sections 5 and 10).
+constexpr double kWarmStartMaxX = 50;
+
+/// Whether an ODE run of this scene (solver.time_step its run step) warm-starts its contacts
+/// (ContactCollider::Settings::warm_start). Never without ode_quickstep (dWorldStep has no use
+/// for it). solver.warm_start when given; unset, on where the linked ODE has them
+/// (odeHasContactWarmStart: rheofeed's patched ODE) and X = e / (|g| h^2) < kWarmStartMaxX
+/// (rheonomic steps of millimetre parts: the main demo's X is 5.1 at h = 0.01 s; full-vibration
+/// steps are far above). At X = 5 they take a heap's drift error at 30 iterations from +10 % to
+/// +5 % at 500 parts, sink fewer parts and cost no more (crowd_leaks.md, section 10).
+bool odeWarmStartsContacts(const Scene& scene);
+/// The same at another step `time_step` (s; the scene check's search for a safe step).
+bool odeWarmStartsContacts(const Scene& scene, double time_step);
 
 }  // namespace rheofeed::scene
