@@ -188,6 +188,30 @@ double stackPenetration(double ratio, int iterations, double h, double edge, Met
   return worst;
 }
 
+// Warm starts unset: on at rheonomic steps of small parts (X = e / (g h^2) below
+// kWarmStartMaxX = 50), off at fine steps; the scene's own setting wins; never without quickstep.
+TEST(SceneCheck, WarmStartsByDefaultOnlyBelowTheMassRatioProbesSafeX) {
+  Scene s;
+  s.fixtures.push_back(floorBox(0.1));
+  const double edge = 0.005;  // X = 5.1 at 10 ms, 51,000 at 0.1 ms
+  s.parts.push_back(cubes(edge, 1000, {-0.3, -0.3, 0.02}, {0.3, 0.3, 0.05}, 10));
+  const double g = norm(s.gravity);
+  const double h_at_limit = std::sqrt(edge / (g * kWarmStartMaxX));  // X = 50 (3.2 ms)
+  const bool patched = odeHasContactWarmStart();
+  EXPECT_EQ(odeWarmStartsContacts(s, 0.01), patched);
+  EXPECT_EQ(odeWarmStartsContacts(s, 1.01 * h_at_limit), patched);  // X just below 50
+  EXPECT_FALSE(odeWarmStartsContacts(s, 0.99 * h_at_limit));        // X just above
+  EXPECT_FALSE(odeWarmStartsContacts(s, 1e-4));
+  s.solver.time_step = 0.01;
+  EXPECT_EQ(odeWarmStartsContacts(s), patched);  // at the scene's own step
+  s.solver.warm_start = false;
+  EXPECT_FALSE(odeWarmStartsContacts(s, 0.01));
+  s.solver.warm_start = true;
+  EXPECT_TRUE(odeWarmStartsContacts(s, 1e-4));  // asked for: even at fine steps
+  s.solver.ode_quickstep = false;
+  EXPECT_FALSE(odeWarmStartsContacts(s, 0.01));  // dWorldStep has no use for it
+}
+
 TEST(SceneCheck, MassRatioFiresWithTheMassesFromDensitiesAndEdges) {
   Scene s;
   s.fixtures.push_back(floorBox(0.1));
