@@ -174,10 +174,10 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
     // wall forwards and inwards at kWiperAngle. Nuts lying flat (5 mm) pass under it; nuts on
     // edge (9-11 mm) or riding on another nut hit it, slide along it and fall off the track's
     // inner edge back into the bowl. Its bottom follows the track's top (which rises along the
-    // helix and falls towards the wall, about 3 mm over the blade's length): a level blade had
-    // 9.5 mm of clearance at the wall, and a 9 mm cube slid along it and under it where its top
-    // overlapped the blade by 1 mm. Its outer end lies in the wall: the end face (square to the
-    // blade) reaches 1 mm into the wall at both its corners.
+    // helix and falls towards the wall, a few mm over the blade's length): under a level blade a
+    // 9 mm cube slid along it and passed where its top overlapped the blade by about 1 mm. Its
+    // outer end lies in the wall: the end face (square to the blade) has one corner 1.6 mm into
+    // the wall and the other beyond its outer face.
     const double blade_height = 0.020, blade_thickness = 0.012;
     const double phi0 = 2 * kPi + kWiperAzimuth;
     const double r0 = kInnerRadius + 0.001 + 0.5 * blade_thickness * std::cos(kWiperAngle),

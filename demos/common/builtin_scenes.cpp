@@ -213,7 +213,8 @@ Scene linearTroughScene(int count, double rate, double amplitude, double frequen
   // through the 10 mm front wall near its lower edge. The side walls reach 5 mm down into the
   // trough's side walls (z = 0.045 to 0.21 m): with their bottom at z = 0.06, 10 mm above the
   // trough walls' top, the heap pressed parts (5 mm thick and up) out through that slot and over
-  // the trough's side (demos/results/crowd_leaks.md, section 10).
+  // the trough's side (demos/results/crowd_leaks.md, section 10). The back wall's bottom is
+  // still 10 mm above the trough's back wall, behind the flow: no part was lost there.
   add(hopper, {0.03, 0.12, 0.15}, {-0.1, 0, 0.135});
   add(hopper, {0.03, 0.12, 0.15}, {0.12, 0, 0.135});
   add(hopper, {0.25, 0.03, 0.165}, {0.01, 0.075, 0.1275});

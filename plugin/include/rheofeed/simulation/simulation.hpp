@@ -176,7 +176,8 @@ struct RunHealth {
   /// reference engine). Informative.
   long warm_started_contacts = 0;
   /// Every part counted above (lost, sunk), in the order found: the first kMaxPartEvents of the
-  /// run, and how many more there were. Written to the run JSON (health.part_events).
+  /// run, and how many more there were. Written to the run JSON (health.part_events). Parts
+  /// inside a fixture (a gauge) are not listed until they are counted otherwise.
   std::vector<PartEvent> part_events;
   long part_events_dropped = 0;
   /// Parts lost in any way but the exit: fell + through_fixture + left_feeder + out_of_bounds +
@@ -355,7 +356,7 @@ FrictionModel odeFrictionModel(const SolverSettings& solver);
 /// Below this X = e / (|g| h^2) (e the thinnest part's smallest size, m; h the run's step, s) an
 /// ODE quickstep run warm-starts its contacts unless the scene says otherwise: the mass-ratio
 /// probe held stacks of unequal parts as well with warm starts as from zero there, and worse at
-/// some grid points above (demos/results/crowd_leaks.md, sections 5 and 10).
+/// some grid points above (demos/results/crowd_leaks.md, sections 5 and 11).
 constexpr double kWarmStartMaxX = 50;
 
 /// Whether an ODE run of this scene (solver.time_step its run step) warm-starts its contacts
@@ -364,7 +365,8 @@ constexpr double kWarmStartMaxX = 50;
 /// (odeHasContactWarmStart: rheofeed's patched ODE) and X = e / (|g| h^2) < kWarmStartMaxX
 /// (rheonomic steps of millimetre parts: the main demo's X is 5.1 at h = 0.01 s; full-vibration
 /// steps are far above). At X = 5 they take a heap's drift error at 30 iterations from +10 % to
-/// +5 % at 500 parts, sink fewer parts and cost no more (crowd_leaks.md, section 10).
+/// +5 % at 500 parts and cost no more; at 2000 parts they sank 1 part against 9 (crowd_leaks.md,
+/// section 11).
 bool odeWarmStartsContacts(const Scene& scene);
 /// The same at another step `time_step` (s; the scene check's search for a safe step).
 bool odeWarmStartsContacts(const Scene& scene, double time_step);
