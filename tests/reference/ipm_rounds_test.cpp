@@ -25,30 +25,33 @@ Settings oneSweepSettings() {
   return s;
 }
 
-/// One step of a 10 cm box sliding at kSpeed on the ground, in contact from the start.
-StepReport slideOneStep(World& world, BoxBody& box) {
-  addGround(world);
-  BodyState state = restingAt({0, 0, 0.5 * kEdge - 1e-6});
-  state.linear_velocity = {kSpeed, 0, 0};
-  box = addBox(world, kMass, {kEdge, kEdge, kEdge}, state);
-  return world.step(kStep);
-}
+/// One step of a 10 cm box sliding at kSpeed on the ground, in contact from the start, in a
+/// world of these settings.
+struct SlideOneStep {
+  explicit SlideOneStep(const Settings& settings) : world(settings) {
+    addGround(world);
+    BodyState state = restingAt({0, 0, 0.5 * kEdge - 1e-6});
+    state.linear_velocity = {kSpeed, 0, 0};
+    box = addBox(world, kMass, {kEdge, kEdge, kEdge}, state);
+    report = world.step(kStep);
+  }
+  bool ode_ready = (initOdeOnce(), true);  // before the world
+  World world;
+  BoxBody box;
+  StepReport report;
+};
 
 TEST(ReferenceIpmRounds, ConvergeWhatOneSweepLeavesAndGiveCoulombsDeceleration) {
-  initOdeOnce();
   Settings alone = oneSweepSettings();
   alone.ipm_rounds = 0;
-  World nsgs_world(alone);
-  BoxBody nsgs_box;
-  const StepReport nsgs_only = slideOneStep(nsgs_world, nsgs_box);
+  const StepReport nsgs_only = SlideOneStep(alone).report;
   ASSERT_EQ(nsgs_only.contacts, 4);
   ASSERT_EQ(nsgs_only.solve.status, ccp::Status::MaxIterations) << "premise: one sweep is short";
   EXPECT_EQ(nsgs_only.ipm_rounds, 0);
 
   const Settings settings = oneSweepSettings();
-  World world(settings);
-  BoxBody box;
-  const StepReport report = slideOneStep(world, box);
+  const SlideOneStep run(settings);
+  const StepReport& report = run.report;
   EXPECT_EQ(report.solve.status, ccp::Status::Converged) << report.solve.message;
   EXPECT_GE(report.ipm_rounds, 1);
   EXPECT_TRUE(report.ipm_not_run.empty()) << report.ipm_not_run;
@@ -56,31 +59,25 @@ TEST(ReferenceIpmRounds, ConvergeWhatOneSweepLeavesAndGiveCoulombsDeceleration) 
   // the compliance (cfm / h times the weight's impulse m g h) and the push-out of the 1 um
   // start penetration (erp depth / h) allow the normal velocity, and mu times that the slide.
   const double slack = settings.cfm * kMass * kGravity + settings.erp * 1e-6 / kStep;  // m/s
-  const BodyState& after = world.state(box.id);
+  const BodyState& after = run.world.state(run.box.id);
   EXPECT_NEAR(after.linear_velocity.x, kSpeed - settings.default_mu * kGravity * kStep,
               settings.default_mu * slack);
   EXPECT_NEAR(after.linear_velocity.z, 0.0, slack);
 }
 
 TEST(ReferenceIpmRounds, AStepAboveTheContactLimitSaysTheRoundsDidNotRun) {
-  initOdeOnce();
   Settings settings = oneSweepSettings();
   settings.ipm_max_contacts = 3;
-  World world(settings);
-  BoxBody box;
-  const StepReport report = slideOneStep(world, box);
+  const StepReport report = SlideOneStep(settings).report;
   EXPECT_EQ(report.solve.status, ccp::Status::MaxIterations);
   EXPECT_EQ(report.ipm_rounds, 0);
   RHEOFEED_EXPECT_CONTAINS(report.ipm_not_run, "4 contacts, above ipm_max_contacts = 3");
 }
 
 TEST(ReferenceIpmRounds, AFrictionlessContactRefusedByTheInteriorPointMethodIsSaid) {
-  initOdeOnce();
   Settings settings = oneSweepSettings();
   settings.default_mu = 0.0;
-  World world(settings);
-  BoxBody box;
-  const StepReport report = slideOneStep(world, box);
+  const StepReport report = SlideOneStep(settings).report;
   ASSERT_EQ(report.solve.status, ccp::Status::MaxIterations) << "premise: one sweep is short";
   EXPECT_EQ(report.ipm_rounds, 0);
   RHEOFEED_EXPECT_CONTAINS(report.ipm_not_run, "has mu = 0");

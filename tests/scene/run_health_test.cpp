@@ -199,7 +199,7 @@ TEST(RunHealth, EveryCountedPartIsAnEventWithTheRunsCount) {
   ASSERT_EQ(h.part_events.size(), 1u);
   EXPECT_EQ(h.part_events[0].kind, "through_fixture");
   EXPECT_EQ(h.part_events[0].fixture, "floor");
-  EXPECT_DOUBLE_EQ(h.part_events[0].time, kStep);
+  EXPECT_DOUBLE_EQ(h.part_events[0].time, kStep);  // simulated time of step 1, not a clock
   EXPECT_DOUBLE_EQ(h.part_events[0].position.z, sim->part(0).position.z);
   EXPECT_EQ(h.part_events_dropped, 0);
 }

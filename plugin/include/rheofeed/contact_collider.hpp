@@ -87,8 +87,10 @@ namespace rheofeed {
 
 /// Fills `contacts[0..count)` (produced by dCollide for geoms o1, o2) with the application's
 /// surface parameters (mode, mu, bounce, soft_erp, ...). Return false to reject the pair. Called
-/// from inside dSpaceCollide. If it throws, the exception is kept and rethrown by
-/// ContactCollider::collide after dSpaceCollide returns (file comment), never through ODE.
+/// from inside dSpaceCollide, never for a pair of two static or kinematic geoms (no body ODE
+/// moves: nothing to constrain; those pairs are not collided at all). If it throws, the exception
+/// is kept and rethrown by ContactCollider::collide after dSpaceCollide returns (file comment),
+/// never through ODE.
 using SurfaceCallback = std::function<bool(dGeomID o1, dGeomID o2, dContact* contacts, int count)>;
 
 /// Collides a space and creates the step's contact joints. Owns its contact joint group.
