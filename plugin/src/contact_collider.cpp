@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "rheofeed/narrow_phase.hpp"
 #include "stage_clock.hpp"
 
 namespace rheofeed {
@@ -165,7 +166,8 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
     return;
   }
   dContact* contacts = buffer_.data();
-  int n = dCollide(o1, o2, settings_.max_contacts_per_pair, &contacts[0].geom, sizeof(dContact));
+  int n = collideSpanning(o1, o2, settings_.max_contacts_per_pair, &contacts[0].geom,
+                          sizeof(dContact), mesh_buffer_);
   if (n <= 0) return;
   if (!sweep_of_geom_.empty()) {  // a swept geom in contact already needs no ray to it
     if (const auto it = sweep_of_geom_.find(o1); it != sweep_of_geom_.end()) {

@@ -97,7 +97,9 @@ using SurfaceCallback = std::function<bool(dGeomID o1, dGeomID o2, dContact* con
 class ContactCollider {
  public:
   struct Settings {
-    /// Contacts asked of dCollide per geom pair (ODE's `flags` low bits), 1..65535.
+    /// Contacts kept per geom pair, 1..65535: dCollide's limit for pairs of primitives; for a
+    /// pair with a triangle mesh every contact is asked for and this many spanning the set
+    /// are kept (collideSpanning, narrow_phase.hpp).
     int max_contacts_per_pair = 8;
     /// Skip pairs whose bodies are already connected by a non-contact joint.
     bool skip_connected_bodies = true;
@@ -223,6 +225,7 @@ class ContactCollider {
   dJointGroupID group_;
   SurfaceCallback surface_;
   std::vector<dContact> buffer_;
+  std::vector<dContactGeom> mesh_buffer_;  // collideSpanning's buffer for pairs with a mesh
   std::deque<dJointFeedback> feedback_;
   std::size_t feedback_used_ = 0;
   std::vector<Joint> joints_;

@@ -24,6 +24,7 @@
 #include "rheofeed/ccp/nsgs.hpp"
 #include "rheofeed/ccp/problem.hpp"
 #include "rheofeed/ccp/solver.hpp"
+#include "rheofeed/narrow_phase.hpp"
 #include "rheofeed/reference/world.hpp"
 
 namespace rheofeed::reference {
@@ -156,7 +157,8 @@ struct WorldState {
   std::map<std::pair<dGeomID, dGeomID>, std::vector<WarmContact>> warm;
   std::vector<char> warm_claimed;  // scratch of warmStartStage
   std::vector<dContactGeom> scratch;
-  ccp::Problem problem;  // the last step's contact problem
+  std::vector<dContactGeom> mesh_scratch;  // collideSpanning's buffer for pairs with a mesh
+  ccp::Problem problem;                    // the last step's contact problem
 
   BodyId bodyOf(dGeomID g) const {
     auto it = attached_index.find(g);
@@ -229,7 +231,8 @@ struct WorldState {
     if (a == b) return;
     const int max = settings.max_contacts_per_pair;
     scratch.resize(static_cast<std::size_t>(max));
-    const int n = dCollide(o1, o2, max, scratch.data(), sizeof(dContactGeom));
+    const int n =
+        rheofeed::collideSpanning(o1, o2, max, scratch.data(), sizeof(dContactGeom), mesh_scratch);
     if (n <= 0) return;
     const double mu = friction ? friction(o1, o2) : settings.default_mu;
     for (int i = 0; i < n; ++i) {

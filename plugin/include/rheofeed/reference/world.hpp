@@ -128,7 +128,7 @@ struct Settings {
   double cfm = 1e-5;          ///< as dWorldSetCFM (ODE's force units, >= 0)
   double max_correcting_velocity = std::numeric_limits<double>::infinity();  ///< (m/s)
   double surface_layer = 0.0;     ///< as dWorldSetContactSurfaceLayer (m)
-  int max_contacts_per_pair = 8;  ///< contacts asked of dCollide per pair
+  int max_contacts_per_pair = 8;  ///< contacts kept per pair (collideSpanning, narrow_phase.hpp)
   double default_mu = 0.5;        ///< friction coefficient when no callback is set
   /// Coefficient of restitution e (dimensionless, 0..1), as ODE's dContactBounce with
   /// surface.bounce = e: when the pre-step approach speed -u_n (m/s) of a contact exceeds
