@@ -372,6 +372,12 @@ double smallestHalfExtent(dGeomID g) {
 // and toppled off the one below. 1e-4 keeps the rays 0.5 um inside a 10 mm cube's faces.
 constexpr double kLeadingPointInset = 1e-4;
 
+// A swept part already touching a triangle mesh (a nut sliding down the bowl's wall) gets
+// speculative contacts with it only where its motion runs into the surface at more than 60
+// degrees from the surface's plane (cosine between motion and normal above 0.5: the ramp below),
+// not along the touched wall, whose own contacts hold it.
+constexpr double kTouchingMeshMinCosine = 0.5;
+
 int leadingPoints(dGeomID g, const dReal dir[3], dReal out[8][3]) {
   const dReal* c = dGeomGetPosition(g);
   const dReal* r = dGeomGetRotation(g);  // row-major 3x4
@@ -512,7 +518,14 @@ void ContactCollider::castSweeps(double step) {
     double gap_speed[8];
     for (dGeomID other : s.candidates) {
       if (other == geom || dGeomGetBody(other) == body) continue;
-      if (std::find(s.touching.begin(), s.touching.end(), other) != s.touching.end()) continue;
+      // A geom the regular pass already gave contacts with needs no ray, unless it is a triangle
+      // mesh: one mesh holds a whole bowl, so a nut sliding down its wall touches it and would
+      // never be swept onto the ramp below. Against a touching mesh only a ray that runs into
+      // the surface steeply (kTouchingMeshMinCosine) counts, not one grazing the touched wall.
+      const bool touching =
+          std::find(s.touching.begin(), s.touching.end(), other) != s.touching.end();
+      if (touching && dGeomGetClass(other) != dTriMeshClass) continue;
+      const double min_along = touching ? kTouchingMeshMinCosine : 1e-6;
       int n = 0;
       for (int i = 0; i < np && n < static_cast<int>(contacts.size()) && n < 8; ++i) {
         if (dGeomGetClass(other) == dBoxClass &&
@@ -527,7 +540,7 @@ void ContactCollider::castSweeps(double step) {
         const double sign =
             along > 0 ? -1.0 : 1.0;  // the normal out of `other`, against the motion
         along = std::fabs(along);
-        if (!(along > 1e-6)) continue;  // grazing: the motion does not close it
+        if (!(along > min_along)) continue;  // grazing: the motion does not close it
         dContactGeom& c = contacts[static_cast<std::size_t>(n)].geom;
         for (int k = 0; k < 3; ++k) {
           c.pos[k] = hit.pos[k];

@@ -184,5 +184,51 @@ TEST(NarrowPhase, CylinderRestsLevelOnAFinelyTessellatedFloorAtTheRheonomicStep)
   dWorldDestroy(world);
 }
 
+// Speculative contacts against a mesh the part already touches: a cylinder sliding down a mesh
+// wall at 1 m/s, h = 0.01 s (10 mm per step), onto a 4 mm shelf of the same mesh. The wall's
+// contacts must not stop the sweep that catches the shelf: the cylinder lands on the shelf's top
+// (centre half its length above z = 0) instead of passing through.
+TEST(NarrowPhase, SpeculativeSweepCatchesAShelfOfTheMeshThePartSlidesDown) {
+  dInitODE2(0);
+  dWorldID world = dWorldCreate();
+  dWorldSetGravity(world, 0, 0, -9.81);
+  dSpaceID space = dSimpleSpaceCreate(nullptr);
+  MeshData mesh;
+  const double wall_x = kRadius - 1e-4, lo = -0.02, top = 0.06, shelf = 0.004;
+  // the wall, facing -x, from z = -shelf to top
+  mesh.quad(mesh.vertex(wall_x, lo, -shelf), mesh.vertex(wall_x, lo, top),
+            mesh.vertex(wall_x, -lo, top), mesh.vertex(wall_x, -lo, -shelf));
+  // the shelf: top face (z = 0, facing +z) and bottom face (z = -shelf, facing -z)
+  mesh.quad(mesh.vertex(lo, lo, 0), mesh.vertex(wall_x, lo, 0), mesh.vertex(wall_x, -lo, 0),
+            mesh.vertex(lo, -lo, 0));
+  mesh.quad(mesh.vertex(lo, lo, -shelf), mesh.vertex(lo, -lo, -shelf),
+            mesh.vertex(wall_x, -lo, -shelf), mesh.vertex(wall_x, lo, -shelf));
+  mesh.build(space);
+  dBodyID body = dBodyCreate(world);
+  dMass mass;
+  dMassSetCylinder(&mass, 7850, 3, kRadius, kLength);
+  dBodySetMass(body, &mass);
+  dGeomID cylinder = dCreateCylinder(space, kRadius, kLength);
+  dGeomSetBody(cylinder, body);
+  dBodySetPosition(body, 0, 0, 0.5 * kLength + 0.025);
+  dBodySetLinearVel(body, 0.02, 0, -1.0);  // pressed on the wall, falling
+  {
+    FeederSet feeders;
+    ContactCollider::Settings settings;
+    settings.speculative = true;
+    settings.default_surface.mu = 0;
+    ContactCollider collider(world, feeders, settings);
+    const double h = 0.01;
+    for (int step = 0; step < 50; ++step) {
+      collider.collide(space, step * h, h);
+      dWorldQuickStep(world, h);
+    }
+  }
+  const dReal* p = dBodyGetPosition(body);
+  EXPECT_NEAR(p[2], 0.5 * kLength, 5e-4);  // m: on the shelf, not through it
+  dSpaceDestroy(space);
+  dWorldDestroy(world);
+}
+
 }  // namespace
 }  // namespace rheofeed::test
