@@ -73,6 +73,16 @@ void addWall(MeshData& mesh, double wall_x, double side, double cell) {
   }
 }
 
+// A steel cylinder (radius kRadius, length kLength, axis +z) on a new body in `world`.
+dBodyID addSteelCylinder(dWorldID world, dSpaceID space) {
+  dBodyID body = dBodyCreate(world);
+  dMass mass;
+  dMassSetCylinder(&mass, 7850, 3, kRadius, kLength);
+  dBodySetMass(body, &mass);
+  dGeomSetBody(dCreateCylinder(space, kRadius, kLength), body);
+  return body;
+}
+
 struct Extent {
   double x = 0, y = 0;
 };
@@ -160,12 +170,7 @@ TEST(NarrowPhase, CylinderRestsLevelOnAFinelyTessellatedFloorAtTheRheonomicStep)
   MeshData mesh;
   addFloor(mesh, 0.04, 0.001);
   mesh.build(space);
-  dBodyID body = dBodyCreate(world);
-  dMass mass;
-  dMassSetCylinder(&mass, 7850, 3, kRadius, kLength);
-  dBodySetMass(body, &mass);
-  dGeomID cylinder = dCreateCylinder(space, kRadius, kLength);
-  dGeomSetBody(cylinder, body);
+  dBodyID body = addSteelCylinder(world, space);
   dBodySetPosition(body, 0.0003, 0.0002, 0.5 * kLength);
   {
     FeederSet feeders;
@@ -204,12 +209,7 @@ TEST(NarrowPhase, SpeculativeSweepCatchesAShelfOfTheMeshThePartSlidesDown) {
   mesh.quad(mesh.vertex(lo, lo, -shelf), mesh.vertex(lo, -lo, -shelf),
             mesh.vertex(wall_x, -lo, -shelf), mesh.vertex(wall_x, lo, -shelf));
   mesh.build(space);
-  dBodyID body = dBodyCreate(world);
-  dMass mass;
-  dMassSetCylinder(&mass, 7850, 3, kRadius, kLength);
-  dBodySetMass(body, &mass);
-  dGeomID cylinder = dCreateCylinder(space, kRadius, kLength);
-  dGeomSetBody(cylinder, body);
+  dBodyID body = addSteelCylinder(world, space);
   dBodySetPosition(body, 0, 0, 0.5 * kLength + 0.025);
   dBodySetLinearVel(body, 0.02, 0, -1.0);  // pressed on the wall, falling
   {
