@@ -424,10 +424,10 @@ TEST(SceneCheck, DemoScenesAreQuietAtTheirSteps) {
   EXPECT_EQ(at2ms[0].kind, Hazard::Kind::MassRatio);
   Scene bowl = loadScene(dir / "bowl_feeder.json");
   expectQuiet(bowl, Method::OdeFullVibration);
-  // At bowl_feeder's rheonomic step, 0.005 s, X = 18: the mass ratio is named (nut blanks 1.83
-  // times apart against a measured 1.5 at 40 iterations, the X = 10 row of
-  // check_mass_ratio.cpp), and nothing else. The mesh bowl does lose nuts at that step (7 of 12
-  // in 60 s, demos/results/bowl_feeder.md), though mostly mesh against mesh.
+  // At bowl_feeder's former rheonomic step, 0.005 s, X = 18: the mass ratio is named (nut
+  // blanks 1.83 times apart against a measured 1.5 at 40 iterations, the X = 10 row of
+  // check_mass_ratio.cpp), and nothing else (the scene now runs at 0.01 s, with no nut lost in
+  // 60 s over 4 seeds: demos/results/bowl_feeder.md, section 8).
   bowl.solver.time_step = 0.005;
   const std::vector<Hazard> at5ms = checkScene(bowl, Method::OdeRheonomic);
   ASSERT_EQ(at5ms.size(), 1u) << formatHazards(at5ms);
