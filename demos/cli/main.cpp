@@ -11,7 +11,9 @@
 // shipped_scenes.hpp) or a scene file. Exit codes: 0 success, 1 a failure while running (check:
 // the scene has hazards), 2 bad input (command line or scene; nothing has run).
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
+#include <exception>
 #include <string>
 
 #include "cli/commands.hpp"
@@ -76,11 +78,39 @@ void addSceneArgs(CLI::App* sub, SceneArgs& a, bool with_methods, bool with_over
       ->each([&a](const std::string&) { a.seed_given = true; });
 }
 
+// CLI11 check: a finite number of vibration cycles, >= 0 (or > 0 when `positive`).
+CLI::Validator cyclesCheck(const char* option, bool positive) {
+  return CLI::Validator(
+      [positive](std::string& text) {
+        double v = 0;
+        try {
+          std::size_t used = 0;
+          v = std::stod(text, &used);
+          if (used != text.size()) v = std::nan("");
+        } catch (const std::exception&) {
+          v = std::nan("");
+        }
+        if (std::isfinite(v) && (positive ? v > 0 : v >= 0) && v <= 1e6) return std::string();
+        return "got " + text + ": must be a finite number of vibration " + "cycles " +
+               (positive ? "> 0" : ">= 0") + " and at most 1e6";
+      },
+      "", option);
+}
+
 void addCalibrateOptions(CLI::App* sub, CalibrateOptions& c) {
   sub->add_flag("--classical", c.classical,
                 "calibrate with the classical single-part model (milliseconds, a straight-track "
                 "estimate) instead of a short full-vibration sample run")
       ->default_str("off");
+  sub->add_option("--warmup-cycles", c.warmup_cycles,
+                  "vibration cycles the sampling run lets pass before it measures (>= 0); a "
+                  "phase the parts reach later, such as a bowl's ramp, needs more")
+      ->check(cyclesCheck("--warmup-cycles", false))
+      ->default_val(c.warmup_cycles);
+  sub->add_option("--measure-cycles", c.measure_cycles,
+                  "vibration cycles the sampling run measures (> 0)")
+      ->check(cyclesCheck("--measure-cycles", true))
+      ->default_val(c.measure_cycles);
 }
 
 }  // namespace

@@ -132,5 +132,34 @@ TEST(CalibrateScene, CalibratesOnlyTheFixturesWhoseDriftModelTakesACalibration) 
   std::fclose(log);
 }
 
+// The sampling run's cycles (CalibrateOptions::warmup_cycles, measure_cycles; `rheofeed
+// calibrate --warmup-cycles --measure-cycles`) reach the sample: the summary names them, and a
+// negative warm-up is refused naming the setting.
+TEST(CalibrateScene, SamplingRunTakesTheWarmupAndMeasuredCyclesOfTheOptions) {
+  Scene s = hoppingTrack();
+  s.fixtures[0].law.drift_model = DriftModel::CalibratedDrift;
+  std::FILE* log = std::tmpfile();
+  ASSERT_NE(log, nullptr);
+  CalibrateOptions options;
+  options.warmup_cycles = 2;
+  options.measure_cycles = 4;
+  Scene sampled = s;
+  const CalibrateReport report = calibrateScene(sampled, options, "test", log);
+  EXPECT_EQ(report.calibrated, 1);
+  EXPECT_NE(report.summary.find("2 cycles of warm-up, 4 measured"), std::string::npos)
+      << report.summary;
+  // A one-cycle hop moves the parts on at the closed form's speed from the first cycle on.
+  const double expected = kPi * kG / std::tan(kBeta) / kW;
+  EXPECT_NEAR(sampled.fixtures[0].law.calibrated_drift.linear.x, expected, 0.2 * expected);
+  options.warmup_cycles = -1;
+  try {
+    calibrateScene(s, options, "test", log);
+    ADD_FAILURE() << "a negative warm-up was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("warmup_cycles >= 0"), std::string::npos) << e.what();
+  }
+  std::fclose(log);
+}
+
 }  // namespace
 }  // namespace rheofeed::scene

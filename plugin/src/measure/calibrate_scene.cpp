@@ -38,8 +38,11 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
           label.c_str(), name.c_str(),
           options.classical ? "classical single-part model" : "short full-vibration sample run");
       std::fflush(log);
+      CalibrationSettings sampling;
+      sampling.warmup_cycles = options.warmup_cycles;
+      sampling.measure_cycles = options.measure_cycles;
       const Calibration c = options.classical ? calibrateClassical(scene, fixture)
-                                              : calibrateBySampling(scene, fixture);
+                                              : calibrateBySampling(scene, fixture, sampling);
       line << "fixture '" << name << "': calibrated_drift ";
       if (law.vibration.torsion_amplitude > 0) {
         line << c.value << " +- " << c.ci95 << " rad/s";
@@ -58,6 +61,8 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
       }
       EfficiencySettings settings;
       settings.rheonomic_time_step = options.rheonomic_time_step;
+      settings.warmup_cycles = options.warmup_cycles;
+      settings.measure_cycles = options.measure_cycles;
       Scene sampled = scene;
       sampled.fixtures[i].law.efficiency.clear();
       for (std::size_t k = 0; k < scene.parts.size(); ++k) {

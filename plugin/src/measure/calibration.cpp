@@ -84,7 +84,10 @@ Calibration calibrateBySampling(const Scene& scene, int fixture,
   c.fixture = fixture;
   c.how = std::string("full-vibration sample (") +
           (settings.use_reference_solver ? "reference" : "ODE") + ", " +
-          std::to_string(sample.parts[0].count) + " parts)";
+          std::to_string(sample.parts[0].count) + " parts, " +
+          std::to_string(settings.steps_per_cycle) + " steps per cycle, " +
+          formatNumber(settings.warmup_cycles) + " cycles of warm-up, " +
+          formatNumber(settings.measure_cycles) + " measured)";
   const std::clock_t start = std::clock();
   const bool screw = v.torsion_amplitude != 0;
   const RunMetrics m = measureRun(sample, method);

@@ -124,6 +124,12 @@ struct CalibrateOptions {
   bool force = false;
   /// The step (s) of the rheonomic runs: calibrateEfficiency runs the local law at it.
   double rheonomic_time_step = 0.01;
+  /// Vibration cycles of the sampling runs (calibrateBySampling, calibrateEfficiency) before
+  /// measuring (finite, >= 0) and measured (finite, > 0). The defaults measure the first two
+  /// seconds of a 50 Hz feeder; a phase that the parts reach later (a bowl's ramp) needs a
+  /// longer warm-up. Checked by the calibrations (std::invalid_argument).
+  double warmup_cycles = 25;
+  double measure_cycles = 75;
 };
 
 /// What calibrateScene did.
