@@ -230,7 +230,7 @@ bool writeOutputs(const DriftModelStudyOptions& o, const std::vector<SceneResult
         "marked, at the steps per cycle given"
      << (o.quick ? ", QUICK run" : "")
      << "); every rheonomic run is ODE + plugin at h = " << o.rheonomic_time_step
-     << " s (or the scene's own solver.rheonomic_time_step: the bowl 0.005 s). Error = (drift - "
+     << " s (or the scene's own solver.rheonomic_time_step where it gives one). Error = (drift - "
         "full vibration) / |full vibration|. Cost = CPU of the run plus "
         "its calibration (sampling runs at the judge's steps per cycle).\n\n"
      << "| scene | full vibration | local | local + sampled efficiency | sampled constant | "
