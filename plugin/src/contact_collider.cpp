@@ -373,10 +373,15 @@ double smallestHalfExtent(dGeomID g) {
 constexpr double kLeadingPointInset = 1e-4;
 
 // A swept part already touching a triangle mesh (a nut sliding down the bowl's wall) gets
-// speculative contacts with it only where its motion runs into the surface at more than 60
+// speculative contacts with it only where its motion runs into the surface at more than 30
 // degrees from the surface's plane (cosine between motion and normal above 0.5: the ramp below),
 // not along the touched wall, whose own contacts hold it.
 constexpr double kTouchingMeshMinCosine = 0.5;
+// ... and only where the surface lies ahead of the ray's start by more than this fraction of the
+// part's smallest half extent (25 um for a 5 mm nut): a resting part's leading points sit on
+// or just above the floor it touches (those below it see only its back faces, which the rays
+// cull), and that floor is held by the regular contacts.
+constexpr double kTouchingMeshMinGap = 0.01;
 
 int leadingPoints(dGeomID g, const dReal dir[3], dReal out[8][3]) {
   const dReal* c = dGeomGetPosition(g);
@@ -506,6 +511,9 @@ void ContactCollider::castSweeps(double step) {
   if (!ray_) {
     ray_ = dCreateRay(nullptr, 1);
     dGeomRaySetClosestHit(ray_, 1);
+    // A ray that starts inside a triangle mesh (a bounding-box corner of a mesh part inside a
+    // neighbour) must not hit that mesh's far side from within: only faces seen from outside.
+    dGeomRaySetBackfaceCull(ray_, 1);
   }
   std::vector<dContact>& contacts = buffer_;
   for (const Sweep& s : sweeps_) {
@@ -521,11 +529,13 @@ void ContactCollider::castSweeps(double step) {
       // A geom the regular pass already gave contacts with needs no ray, unless it is a triangle
       // mesh: one mesh holds a whole bowl, so a nut sliding down its wall touches it and would
       // never be swept onto the ramp below. Against a touching mesh only a ray that runs into
-      // the surface steeply (kTouchingMeshMinCosine) counts, not one grazing the touched wall.
+      // the surface steeply (kTouchingMeshMinCosine) and hits it ahead of the part
+      // (kTouchingMeshMinGap) counts: not the touched wall it grazes, nor the floor it rests on.
       const bool touching =
           std::find(s.touching.begin(), s.touching.end(), other) != s.touching.end();
       if (touching && dGeomGetClass(other) != dTriMeshClass) continue;
       const double min_along = touching ? kTouchingMeshMinCosine : 1e-6;
+      const double min_distance = touching ? kTouchingMeshMinGap * smallestHalfExtent(geom) : 0.0;
       int n = 0;
       for (int i = 0; i < np && n < static_cast<int>(contacts.size()) && n < 8; ++i) {
         if (dGeomGetClass(other) == dBoxClass &&
@@ -535,6 +545,7 @@ void ContactCollider::castSweeps(double step) {
         dGeomRaySet(ray_, points[i][0], points[i][1], points[i][2], s.dir[0], s.dir[1], s.dir[2]);
         dContactGeom hit;
         if (dCollide(ray_, other, 1, &hit, sizeof hit) < 1) continue;
+        if (!(hit.depth > min_distance)) continue;  // a touched mesh's surface at the part
         double along =
             hit.normal[0] * s.dir[0] + hit.normal[1] * s.dir[1] + hit.normal[2] * s.dir[2];
         const double sign =

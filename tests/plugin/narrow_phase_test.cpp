@@ -83,6 +83,35 @@ dBodyID addSteelCylinder(dWorldID world, dSpaceID space) {
   return body;
 }
 
+// A world (gravity 9.81 m/s^2 along -z) whose simple space holds a floor of 1 mm triangles,
+// `side` m square, and a steel cylinder lying on it at (x, y); run() steps it through a
+// ContactCollider at h.
+struct CylinderOnMeshFloor {
+  dWorldID world = dWorldCreate();
+  dSpaceID space = dSimpleSpaceCreate(nullptr);
+  MeshData mesh;
+  dBodyID body = nullptr;
+  CylinderOnMeshFloor(double side, double x, double y) {
+    dWorldSetGravity(world, 0, 0, -9.81);
+    addFloor(mesh, side, 0.001);
+    mesh.build(space);
+    body = addSteelCylinder(world, space);
+    dBodySetPosition(body, x, y, 0.5 * kLength);
+  }
+  ~CylinderOnMeshFloor() {  // geoms before the mesh data (a member, destroyed after this)
+    dSpaceDestroy(space);
+    dWorldDestroy(world);
+  }
+  void run(const ContactCollider::Settings& settings, int steps, double h) {
+    FeederSet feeders;
+    ContactCollider collider(world, feeders, settings);
+    for (int step = 0; step < steps; ++step) {
+      collider.collide(space, step * h, h);
+      dWorldQuickStep(world, h);
+    }
+  }
+};
+
 struct Extent {
   double x = 0, y = 0;
 };
@@ -164,29 +193,12 @@ TEST(NarrowPhase, CylinderInACornerKeepsAContactOnTheFloorAndOnTheWall) {
 // ContactCollider at h = 0.01 s for 2 s, stays level at half its length above the floor.
 TEST(NarrowPhase, CylinderRestsLevelOnAFinelyTessellatedFloorAtTheRheonomicStep) {
   dInitODE2(0);
-  dWorldID world = dWorldCreate();
-  dWorldSetGravity(world, 0, 0, -9.81);
-  dSpaceID space = dSimpleSpaceCreate(nullptr);
-  MeshData mesh;
-  addFloor(mesh, 0.04, 0.001);
-  mesh.build(space);
-  dBodyID body = addSteelCylinder(world, space);
-  dBodySetPosition(body, 0.0003, 0.0002, 0.5 * kLength);
-  {
-    FeederSet feeders;
-    ContactCollider collider(world, feeders);
-    const double h = 0.01;
-    for (int step = 0; step < 200; ++step) {
-      collider.collide(space, step * h, h);
-      dWorldQuickStep(world, h);
-    }
-  }
-  const dReal* p = dBodyGetPosition(body);
-  const dReal* r = dBodyGetRotation(body);
+  CylinderOnMeshFloor scene(0.04, 0.0003, 0.0002);
+  scene.run(ContactCollider::Settings{}, 200, 0.01);
+  const dReal* p = dBodyGetPosition(scene.body);
+  const dReal* r = dBodyGetRotation(scene.body);
   EXPECT_NEAR(p[2], 0.5 * kLength, 2e-4);                   // m: sunk or tipped by less than 0.2 mm
   EXPECT_GT(std::fabs(r[10]), std::cos(1.0 * M_PI / 180));  // axis within 1 degree of +z
-  dSpaceDestroy(space);
-  dWorldDestroy(world);
 }
 
 // Speculative contacts against a mesh the part already touches: a cylinder sliding down a mesh
@@ -228,6 +240,24 @@ TEST(NarrowPhase, SpeculativeSweepCatchesAShelfOfTheMeshThePartSlidesDown) {
   EXPECT_NEAR(p[2], 0.5 * kLength, 5e-4);  // m: on the shelf, not through it
   dSpaceDestroy(space);
   dWorldDestroy(world);
+}
+
+// The other side of that sweep: a part sliding on a mesh floor at h = 0.01 s is swept every step
+// (gravity alone moves it 1 mm per step), and the rays must not hold it on the floor it touches:
+// a cylinder launched at 0.3 m/s with mu = 0.3 stops after v^2 / (2 mu g) = 15.3 mm, as Coulomb
+// friction alone would stop it.
+TEST(NarrowPhase, PartSlidingOnAMeshFloorStopsWhereCoulombFrictionStopsIt) {
+  dInitODE2(0);
+  CylinderOnMeshFloor scene(0.08, -0.02, 0.0002);
+  const double v0 = 0.3, mu = 0.3, g = 9.81;
+  dBodySetLinearVel(scene.body, v0, 0, 0);
+  ContactCollider::Settings settings;
+  settings.speculative = true;
+  settings.default_surface.mu = mu;
+  scene.run(settings, 50, 0.01);
+  const double expected = v0 * v0 / (2 * mu * g);  // m
+  EXPECT_NEAR(dBodyGetPosition(scene.body)[0] + 0.02, expected, 0.1 * expected);
+  EXPECT_NEAR(dBodyGetLinearVel(scene.body)[0], 0.0, 1e-3);  // m/s: stopped
 }
 
 }  // namespace
