@@ -121,7 +121,9 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
       "use the local vibration law, no calibration; against this bowl's own full vibration (ODE, "
       "friction cone) at 2000 steps per cycle it is within 3 % on the floor and 9 % on the ramp "
       "(demos/results/bowl_local_law.md, last section). calibrated_drift: 0.313 rad/s about +z, "
-      "bowl_feeder.json's calibration on its ramp, kept for `--drift-model calibrated_drift`; it "
+      "the mesh bowl's former calibration on its ramp (measured while ODE kept 8 contacts per "
+      "mesh pair, since void there: bowl_feeder.json is now 0.212), kept here for "
+      "`--drift-model calibrated_drift` and as the rotation the tooling tests' kinematics use; it "
       "is not this bowl's (its runs are 13 % fast on the floor and 2-3x on the ramp).");
   insertComment(json, "\"name\": \"m6_nuts\",",
                 "M6 nut blanks (10 mm across flats, 5 mm thick, 2.3 g with the 6 mm hole) as ODE "
