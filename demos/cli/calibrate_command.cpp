@@ -85,6 +85,11 @@ int calibrateCommand(const CalibrateArgs& args) {
                    "rheofeed calibrate: the scene gives the calibration of every vibrating "
                    "fixture that takes one; writing it unchanged (--force calibrates again)\n");
     }
+    if (args.cycles_given && (report.calibrated == 0 || options.classical)) {
+      std::fprintf(
+          stderr, "rheofeed calibrate: note: --warmup-cycles / --measure-cycles ignored: %s\n",
+          options.classical ? "--classical runs no sampling run" : "nothing was calibrated");
+    }
     const std::filesystem::path folder = out.parent_path().empty() ? "." : out.parent_path();
     for (Fixture& f : scene.fixtures) {
       for (Fixture::Geom& g : f.geoms) g.shape.mesh = relativeTo(g.shape.mesh, folder);

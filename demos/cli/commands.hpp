@@ -46,6 +46,9 @@ struct CalibrateArgs {
   SceneArgs scene;
   std::string out;
   CalibrateOptions calibrate;
+  /// --warmup-cycles or --measure-cycles given: said to be ignored when no sampling run takes
+  /// them (--classical, or every calibration given by the scene without --force).
+  bool cycles_given = false;
 };
 int calibrateCommand(const CalibrateArgs& args);
 

@@ -103,12 +103,12 @@ void addCalibrateOptions(CLI::App* sub, CalibrateOptions& c) {
                 "estimate) instead of a short full-vibration sample run")
       ->default_str("off");
   sub->add_option("--warmup-cycles", c.warmup_cycles,
-                  "vibration cycles the sampling run lets pass before it measures (>= 0); a "
-                  "phase the parts reach later, such as a bowl's ramp, needs more")
+                  "vibration cycles the sampling run lets pass before it measures (0 to 1e6); "
+                  "a phase the parts reach later, such as a bowl's ramp, needs more")
       ->check(cyclesCheck("--warmup-cycles", false))
       ->default_val(c.warmup_cycles);
   sub->add_option("--measure-cycles", c.measure_cycles,
-                  "vibration cycles the sampling run measures (> 0)")
+                  "vibration cycles the sampling run measures (> 0, at most 1e6)")
       ->check(cyclesCheck("--measure-cycles", true))
       ->default_val(c.measure_cycles);
 }
@@ -243,7 +243,10 @@ int main(int argc, char** argv) {
   }
   run.animation = !no_animation;
   if (run_cmd->parsed()) return runCommand(run);
-  if (cal_cmd->parsed()) return calibrateCommand(cal);
+  if (cal_cmd->parsed()) {
+    cal.cycles_given = cal_cmd->count("--warmup-cycles") + cal_cmd->count("--measure-cycles") > 0;
+    return calibrateCommand(cal);
+  }
   if (check_cmd->parsed()) return checkCommand(check);
   if (study_cmd->parsed()) return studyCommand(study);
   if (job_cmd->parsed()) return sweepJobCommand(sweep_job);
