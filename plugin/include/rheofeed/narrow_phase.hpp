@@ -123,7 +123,7 @@ inline void dropTrimeshCullingMessage(int num, const char* format, va_list ap) {
   std::vsnprintf(text, sizeof text, format, copy);
   va_end(copy);
   if (std::strstr(text, "hash table bucket overflow") != nullptr) return;
-  if (forward_message != nullptr) {
+  if (forward_message != nullptr && forward_message != &dropTrimeshCullingMessage) {
     forward_message(num, format, ap);
     return;
   }
@@ -132,11 +132,13 @@ inline void dropTrimeshCullingMessage(int num, const char* format, va_list ap) {
   std::fflush(stderr);
 }
 
-// Installs dropTrimeshCullingMessage for its lifetime (one dCollide call).
+// Installs dropTrimeshCullingMessage for its lifetime (one dCollide call). ODE's handler is one
+// global pointer: when the filter is already installed (another thread colliding at the same
+// time), the handler it forwards to stays the one found first.
 class TrimeshCullingMessageFilter {
  public:
   TrimeshCullingMessageFilter() : previous_(dGetMessageHandler()) {
-    forward_message = previous_;
+    if (previous_ != &dropTrimeshCullingMessage) forward_message = previous_;
     dSetMessageHandler(&dropTrimeshCullingMessage);
   }
   ~TrimeshCullingMessageFilter() { dSetMessageHandler(previous_); }
