@@ -50,6 +50,13 @@ std::string jsonString(const std::string& text) {
 
 }  // namespace
 
+void noteIgnoredCycleOptions(const char* program, bool cycles_given, bool calibrated,
+                             bool classical) {
+  if (!cycles_given || (calibrated && !classical)) return;
+  std::fprintf(stderr, "%s: note: --warmup-cycles / --measure-cycles ignored: %s\n", program,
+               classical ? "--classical runs no sampling run" : "nothing was calibrated");
+}
+
 int calibrateCommand(const CalibrateArgs& args) {
   Plan plan;
   const std::filesystem::path out(args.out);
@@ -85,11 +92,8 @@ int calibrateCommand(const CalibrateArgs& args) {
                    "rheofeed calibrate: the scene gives the calibration of every vibrating "
                    "fixture that takes one; writing it unchanged (--force calibrates again)\n");
     }
-    if (args.cycles_given && (report.calibrated == 0 || options.classical)) {
-      std::fprintf(
-          stderr, "rheofeed calibrate: note: --warmup-cycles / --measure-cycles ignored: %s\n",
-          options.classical ? "--classical runs no sampling run" : "nothing was calibrated");
-    }
+    noteIgnoredCycleOptions("rheofeed calibrate", args.cycles_given, report.calibrated > 0,
+                            options.classical);
     const std::filesystem::path folder = out.parent_path().empty() ? "." : out.parent_path();
     for (Fixture& f : scene.fixtures) {
       for (Fixture::Geom& g : f.geoms) g.shape.mesh = relativeTo(g.shape.mesh, folder);

@@ -30,8 +30,15 @@ struct RunArgs {
   /// after them; empty: none.
   std::string drift_table;
   bool drift_table_given = false;
+  /// --warmup-cycles or --measure-cycles given (noteIgnoredCycleOptions).
+  bool cycles_given = false;
 };
 int runCommand(const RunArgs& args);
+
+/// Says on stderr ("<program>: note: ... ignored: <why>") that --warmup-cycles / --measure-cycles
+/// were given but no sampling run took them: nothing calibrated, or --classical.
+void noteIgnoredCycleOptions(const char* program, bool cycles_given, bool calibrated,
+                             bool classical);
 
 /// `rheofeed check SCENE`: loads and validates the scene, then prints the hazards of the scene
 /// check (check.hpp) for each method at the step it would take. Exit code 0 when there is no

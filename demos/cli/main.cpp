@@ -242,7 +242,10 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;  // --help and --version: 0; any bad command line: 2
   }
   run.animation = !no_animation;
-  if (run_cmd->parsed()) return runCommand(run);
+  if (run_cmd->parsed()) {
+    run.cycles_given = run_cmd->count("--warmup-cycles") + run_cmd->count("--measure-cycles") > 0;
+    return runCommand(run);
+  }
   if (cal_cmd->parsed()) {
     cal.cycles_given = cal_cmd->count("--warmup-cycles") + cal_cmd->count("--measure-cycles") > 0;
     return calibrateCommand(cal);

@@ -239,7 +239,10 @@ int runCommand(const RunArgs& args) {
     for (const PlannedRun& r : plan.runs)
       any_rheonomic = any_rheonomic || !isFullVibration(r.method);
     Scene calibrated = plan.scene;
-    if (any_rheonomic && needsCalibration(calibrated)) {
+    const bool calibrating = any_rheonomic && needsCalibration(calibrated);
+    noteIgnoredCycleOptions("rheofeed run", args.cycles_given, calibrating,
+                            args.calibrate.classical);
+    if (calibrating) {
       CalibrateOptions options = args.calibrate;
       for (const PlannedRun& r : plan.runs) {  // local_sampled: measured at the rheonomic step
         if (!isFullVibration(r.method)) options.rheonomic_time_step = r.scene.solver.time_step;

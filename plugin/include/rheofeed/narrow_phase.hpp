@@ -72,8 +72,10 @@ inline int keepSpanningContacts(std::vector<dContactGeom>& all, int max, dContac
   std::swap(all[0], all[deepest]);
   double s = 0;
   for (std::size_t i = 1; i < n; ++i) s = std::max(s, contactSpan(all[i], all[0], 0.0));
-  // gap[i]: candidate i's distance to the nearest contact kept so far (all[0..kept)).
-  std::vector<double> gap(n);
+  // gap[i]: candidate i's distance to the nearest contact kept so far (all[0..kept)); kept
+  // between calls so that a pair's collision allocates nothing once it has grown.
+  thread_local std::vector<double> gap;
+  gap.assign(n, 0.0);
   // contacts touching or apart (depth <= 0) still count, as if 1e-6 of the deepest in
   const double depth_floor = std::max(1e-6 * all[0].depth, 1e-12);
   for (std::size_t i = 1; i < n; ++i) gap[i] = contactSpan(all[i], all[0], s);
