@@ -91,7 +91,7 @@ CLI::Validator cyclesCheck(const char* option, bool positive) {
           v = std::nan("");
         }
         if (std::isfinite(v) && (positive ? v > 0 : v >= 0) && v <= 1e6) return std::string();
-        return "got " + text + ": must be a finite number of vibration " + "cycles " +
+        return "got " + text + ": must be a finite number of vibration cycles " +
                (positive ? "> 0" : ">= 0") + " and at most 1e6";
       },
       "", option);
