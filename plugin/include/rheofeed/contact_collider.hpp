@@ -82,6 +82,7 @@
 #include <vector>
 
 #include "rheofeed/feeder_set.hpp"
+#include "rheofeed/narrow_phase.hpp"
 
 namespace rheofeed {
 
@@ -225,7 +226,7 @@ class ContactCollider {
   dJointGroupID group_;
   SurfaceCallback surface_;
   std::vector<dContact> buffer_;
-  std::vector<dContactGeom> mesh_buffer_;  // collideSpanning's buffer for pairs with a mesh
+  MeshCollisionScratch mesh_buffer_;  // collideSpanning's memory for pairs with a mesh
   std::deque<dJointFeedback> feedback_;
   std::size_t feedback_used_ = 0;
   std::vector<Joint> joints_;

@@ -157,8 +157,8 @@ struct WorldState {
   std::map<std::pair<dGeomID, dGeomID>, std::vector<WarmContact>> warm;
   std::vector<char> warm_claimed;  // scratch of warmStartStage
   std::vector<dContactGeom> scratch;
-  std::vector<dContactGeom> mesh_scratch;  // collideSpanning's buffer for pairs with a mesh
-  ccp::Problem problem;                    // the last step's contact problem
+  rheofeed::MeshCollisionScratch mesh_scratch;  // collideSpanning's memory for pairs with a mesh
+  ccp::Problem problem;                         // the last step's contact problem
 
   BodyId bodyOf(dGeomID g) const {
     auto it = attached_index.find(g);
