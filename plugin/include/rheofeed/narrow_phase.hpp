@@ -29,18 +29,25 @@
 /// that the same contacts come in the same order from step to step (the reference world's warm
 /// start falls back on the index). Pairs without a mesh go to dCollide(o1, o2, max) unchanged.
 ///
-/// Before that reduction, collideSpanning corrects the normals ODE takes from the tessellation
-/// (the internal-edge problem of triangle meshes): ODE tests a mesh triangle by triangle, and a
-/// triangle's edge that pokes a fraction of a millimetre past a part's side face gives a contact
-/// with that side face's normal, horizontal on a flat floor, although the floor continues on the
-/// next triangle: the part snags on a seam that is not there. A contact whose normal, turned out
-/// of a mesh, is more than kSmoothEdgeAngle from the face normal of that mesh's triangle, at a
-/// point inside the triangle or beside edges across which the surface continues within
-/// kSmoothEdgeAngle (MeshEdges), gets the triangle's face normal and, as depth, how far its point
-/// lies below the triangle's plane (0 when on it). Contacts at a sharp edge (a rim, the corner of
-/// floor and wall, the mesh's border) keep ODE's normal. One mesh nut at h = 0.01 s on the local
-/// law in the mesh bowl snagged on the floor's seams and turned 27 % slower than full vibration
-/// (demos/results/bowl_feeder.md, section 9).
+/// Before that reduction, collideSpanning corrects the normals ODE takes from the tessellation of
+/// a fixture (the internal-edge problem of triangle meshes). ODE tests a mesh triangle by
+/// triangle, and a floor triangle's edge that pokes a fraction of a millimetre past a mesh part's
+/// side face gives a contact with that side face's normal, horizontal on a flat floor, although
+/// the floor continues on the next triangle: the part snags on a seam that is not there. Only
+/// fixture meshes are corrected (MeshCollisionScratch::is_fixture: by default a geom without a
+/// body or with a kinematic one): a fixture is locally a plane wherever its surface is smooth,
+/// and the contact normal of a plane is its own. A contact whose normal, turned out of the
+/// fixture, is more than kFaceNormalTolerance from the face normal of the fixture's triangle, at a
+/// point over that triangle whose nearby edges and corners are all smooth (MeshEdges: the surface
+/// continues across them within kSmoothEdgeAngle), gets the triangle's face normal; its depth is
+/// the partner's penetration below the triangle's plane (the deepest corner of a mesh partner's
+/// triangle, else the contact point's depth, and at least ODE's depth times the cosine between
+/// the two normals). Contacts at a sharp edge or corner (a rim, the corner of floor and wall, the
+/// mesh's border), beside the triangle, on merged contacts whose triangle ODE forgot, and with
+/// convex geoms (whose triangle index ODE does not give; ODE corrects those itself) keep ODE's
+/// normal. A mesh nut on a belt of 1 mm triangles at h = 0.01 s was carried at 65 % of the belt's
+/// speed with ODE's normals (Plugin.NarrowPhase.MeshNutOnATessellatedBeltIsCarriedAtTheBeltSpeed);
+/// the mesh bowl: demos/results/bowl_feeder.md, section 9.
 ///
 /// Header only: the plugin's ContactCollider and the reference world (which does not link the
 /// plugin library) both use it.
@@ -55,6 +62,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <tuple>
 #include <unordered_map>
 #include <vector>
@@ -72,11 +80,17 @@ inline constexpr int kMeshContactCapacityLimit = 4096;
 /// (60-90 degrees on a hexagonal nut).
 inline constexpr double kSmoothEdgeAngle = 10.0;
 
+/// A contact normal within this angle (degrees) of its fixture triangle's face normal is that
+/// normal (rounding): any other, averaged ones included, is a candidate for the correction.
+inline constexpr double kFaceNormalTolerance = 0.1;
+
 /// For each triangle edge of one triangle mesh (ODE's geom), whether the surface continues
-/// smoothly across it (kSmoothEdgeAngle; consistent winding, exactly two triangles on the edge).
-/// Vertices are matched by position (STL files repeat them per triangle), to 1e-7 of the mesh's
-/// size. Built from the geom's triangles in the world frame: the angles do not depend on where
-/// the mesh is.
+/// smoothly across it (kSmoothEdgeAngle; consistent winding, exactly two triangles on the edge),
+/// and for each corner whether every edge at its vertex does. Vertices are matched by position
+/// (STL files repeat them per triangle), rounded to a grid of 1e-7 of the mesh's size (exact
+/// copies always match). Built from the geom's triangles in the world frame: the angles do not
+/// depend on where the mesh is. A mesh whose vertices move (dGeomTriMeshDataUpdate) is not
+/// noticed.
 class MeshEdges {
  public:
   explicit MeshEdges(dGeomID mesh) {
@@ -149,21 +163,38 @@ class MeshEdges {
       }
     }
     const double cos_smooth = std::cos(kSmoothEdgeAngle * 3.14159265358979323846 / 180.0);
+    // a corner is smooth when every edge at its vertex is (and it has edges: not a lone point)
+    std::vector<std::uint8_t> sharp_vertex(static_cast<std::size_t>(next_id), 0);
     for (const auto& entry : edges) {
       const std::vector<Side>& sides = entry.second;
-      if (sides.size() != 2 || sides[0].from != sides[1].to) continue;
-      const Normal n0 = faceNormal(&v[9 * static_cast<std::size_t>(sides[0].triangle)]);
-      const Normal n1 = faceNormal(&v[9 * static_cast<std::size_t>(sides[1].triangle)]);
-      if (!n0.valid || !n1.valid) continue;
-      if (n0.x * n1.x + n0.y * n1.y + n0.z * n1.z < cos_smooth) continue;
+      bool smooth = sides.size() == 2 && sides[0].from == sides[1].to;
+      if (smooth) {
+        const Normal n0 = faceNormal(&v[9 * static_cast<std::size_t>(sides[0].triangle)]);
+        const Normal n1 = faceNormal(&v[9 * static_cast<std::size_t>(sides[1].triangle)]);
+        smooth = n0.valid && n1.valid && n0.x * n1.x + n0.y * n1.y + n0.z * n1.z >= cos_smooth;
+      }
+      if (!smooth) {
+        sharp_vertex[static_cast<std::size_t>(sides[0].from)] = 1;
+        sharp_vertex[static_cast<std::size_t>(sides[0].to)] = 1;
+        continue;
+      }
       for (const Side& sd : sides) {
         smooth_[static_cast<std::size_t>(sd.triangle)] |= static_cast<std::uint8_t>(1u << sd.edge);
+      }
+    }
+    for (int t = 0; t < triangles_; ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const int vertex = id[3 * static_cast<std::size_t>(t) + static_cast<std::size_t>(k)];
+        if (!sharp_vertex[static_cast<std::size_t>(vertex)]) {
+          smooth_[static_cast<std::size_t>(t)] |= static_cast<std::uint8_t>(1u << (3 + k));
+        }
       }
     }
   }
 
   /// Whether this table was built for `mesh`'s triangles (its count and the edge lengths of its
-  /// first and last triangle): ODE may reuse a destroyed mesh's address for another.
+  /// first and last triangle): the key is the mesh data's address, which ODE may reuse for
+  /// another mesh once one is destroyed.
   bool describes(dGeomID mesh) const {
     const int n = dGeomTriMeshGetTriangleCount(mesh);
     if (n != triangles_) return false;
@@ -182,6 +213,13 @@ class MeshEdges {
   bool smooth(int triangle, int edge) const {
     if (triangle < 0 || triangle >= triangles_ || edge < 0 || edge > 2) return false;
     return (smooth_[static_cast<std::size_t>(triangle)] >> edge) & 1u;
+  }
+
+  /// Whether the surface is smooth all round corner `corner` (0, 1, 2) of triangle `triangle`:
+  /// every edge at that vertex is smooth; false for an index out of range.
+  bool smoothCorner(int triangle, int corner) const {
+    if (triangle < 0 || triangle >= triangles_ || corner < 0 || corner > 2) return false;
+    return (smooth_[static_cast<std::size_t>(triangle)] >> (3 + corner)) & 1u;
   }
 
   int triangles() const { return triangles_; }
@@ -230,7 +268,7 @@ class MeshEdges {
 
   int triangles_ = 0;
   Fingerprint fingerprint_;
-  std::vector<std::uint8_t> smooth_;  // bit k: edge k of the triangle is smooth
+  std::vector<std::uint8_t> smooth_;  // bit k: edge k is smooth; bit 3 + k: corner k is
 };
 
 /// collideSpanning's working memory, kept by the caller between calls: the contact buffer, and
@@ -239,6 +277,15 @@ class MeshEdges {
 struct MeshCollisionScratch {
   std::vector<dContactGeom> contacts;
   std::unordered_map<dTriMeshDataID, MeshEdges> edges;
+  /// Which meshes are fixtures, whose normals are corrected (file comment). Null: a geom with no
+  /// body or a kinematic one. The reference world, whose geoms carry no ODE bodies, sets its own.
+  std::function<bool(dGeomID)> is_fixture;
+
+  bool fixture(dGeomID g) const {
+    if (is_fixture) return is_fixture(g);
+    const dBodyID b = dGeomGetBody(g);
+    return b == nullptr || dBodyIsKinematic(b);
+  }
 
   const MeshEdges& edgesOf(dGeomID mesh) {
     const dTriMeshDataID data = dGeomTriMeshGetTriMeshDataID(mesh);
@@ -313,67 +360,76 @@ inline int keepFirstTriangle(dGeomID, int first, int) {
   return first;
 }
 
-/// The internal-edge correction of the file comment, for contact c: returns whether it changed
-/// the contact. Of the meshes among c's two geoms, the one whose face normal is closest to ODE's
-/// normal decides.
-inline bool correctInternalEdgeNormal(dContactGeom& c, MeshCollisionScratch& scratch) {
-  const double cos_smooth = std::cos(kSmoothEdgeAngle * 3.14159265358979323846 / 180.0);
-  bool have = false;
-  double best_cos = -2, best_n[3] = {0, 0, 0}, best_depth = 0;
-  for (int which = 0; which < 2; ++which) {
-    const dGeomID g = which == 0 ? c.g1 : c.g2;
-    const int triangle = which == 0 ? c.side1 : c.side2;
-    if (g == nullptr || dGeomGetClass(g) != dTriMeshClass || triangle < 0) continue;
-    const MeshEdges& edges = scratch.edgesOf(g);
-    if (triangle >= edges.triangles()) continue;
-    dVector3 a, b, cc;
-    dGeomTriMeshGetTriangle(g, triangle, &a, &b, &cc);
-    const double v[9] = {a[0], a[1], a[2], b[0], b[1], b[2], cc[0], cc[1], cc[2]};
-    const MeshEdges::Normal f = MeshEdges::faceNormal(v);
-    if (!f.valid) continue;
-    // ODE's normal points out of g2 into g1: turned out of this mesh
-    const double sign = which == 1 ? 1.0 : -1.0;
-    const double cos_f = sign * (c.normal[0] * f.x + c.normal[1] * f.y + c.normal[2] * f.z);
-    if (cos_f >= cos_smooth) continue;  // the face's own normal, or close to it
-    // where the contact lies on the triangle: inside, or beside which edges
-    const double dist = (c.pos[0] - v[0]) * f.x + (c.pos[1] - v[1]) * f.y + (c.pos[2] - v[2]) * f.z;
-    const double q[3] = {c.pos[0] - dist * f.x, c.pos[1] - dist * f.y, c.pos[2] - dist * f.z};
-    double longest = 0;
-    double inside[3];
-    for (int k = 0; k < 3; ++k) {
-      const double* p0 = v + 3 * k;
-      const double* p1 = v + 3 * ((k + 1) % 3);
-      const double e[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-      const double len = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-      longest = std::max(longest, len);
-      // in-plane normal of the edge, pointing into the triangle: f x e / |e|
-      const double m[3] = {f.y * e[2] - f.z * e[1], f.z * e[0] - f.x * e[2],
-                           f.x * e[1] - f.y * e[0]};
-      inside[k] =
-          len > 0 ? ((q[0] - p0[0]) * m[0] + (q[1] - p0[1]) * m[1] + (q[2] - p0[2]) * m[2]) / len
-                  : 0.0;
-    }
-    // beside an edge: within the contact's depth of it, or 1 % of the triangle's size
-    const double near = std::max(std::abs(c.depth), 0.01 * longest);
-    bool sharp = false;
-    for (int k = 0; k < 3; ++k) {
-      if (inside[k] < near && !edges.smooth(triangle, k)) sharp = true;
-    }
-    if (sharp) continue;
-    if (cos_f > best_cos) {
-      have = true;
-      best_cos = cos_f;
-      best_n[0] = sign * f.x;
-      best_n[1] = sign * f.y;
-      best_n[2] = sign * f.z;
-      best_depth = std::max(0.0, -dist);
+/// Partner classes whose contacts with a mesh name the mesh's triangle in side1 / side2 (ODE
+/// 0.16.2); the convex-trimesh collider gives a position in its own list instead.
+inline bool namesTheTriangle(dGeomID partner) {
+  const int c = dGeomGetClass(partner);
+  return c == dTriMeshClass || c == dBoxClass || c == dSphereClass || c == dCapsuleClass ||
+         c == dCylinderClass;
+}
+
+/// The internal-edge correction of the file comment for contact c, whose fixture mesh is
+/// `fixture` (c.g1 or c.g2) with edge table `edges`: returns whether it changed the contact.
+inline bool correctInternalEdgeNormal(dContactGeom& c, dGeomID fixture, const MeshEdges& edges) {
+  const bool fixture_is_g2 = c.g2 == fixture;
+  const int triangle = fixture_is_g2 ? c.side2 : c.side1;
+  const dGeomID partner = fixture_is_g2 ? c.g1 : c.g2;
+  if (triangle < 0 || triangle >= edges.triangles() || !namesTheTriangle(partner)) return false;
+  dVector3 a, b, cc;
+  dGeomTriMeshGetTriangle(fixture, triangle, &a, &b, &cc);
+  const double v[9] = {a[0], a[1], a[2], b[0], b[1], b[2], cc[0], cc[1], cc[2]};
+  const MeshEdges::Normal f = MeshEdges::faceNormal(v);
+  if (!f.valid) return false;
+  // ODE's normal points out of g2 into g1: turned out of the fixture
+  const double sign = fixture_is_g2 ? 1.0 : -1.0;
+  const double cos_f = sign * (c.normal[0] * f.x + c.normal[1] * f.y + c.normal[2] * f.z);
+  // the face's own normal (to rounding): nothing to correct
+  if (cos_f >= std::cos(kFaceNormalTolerance * 3.14159265358979323846 / 180.0)) return false;
+  // where the contact lies over the triangle: signed distances to its edges, inwards
+  const double dist = (c.pos[0] - v[0]) * f.x + (c.pos[1] - v[1]) * f.y + (c.pos[2] - v[2]) * f.z;
+  const double q[3] = {c.pos[0] - dist * f.x, c.pos[1] - dist * f.y, c.pos[2] - dist * f.z};
+  double longest = 0, inside[3];
+  for (int k = 0; k < 3; ++k) {
+    const double* p0 = v + 3 * k;
+    const double* p1 = v + 3 * ((k + 1) % 3);
+    const double e[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+    const double len = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    longest = std::max(longest, len);
+    // f x e / |e|: the edge's in-plane normal, into the triangle (counter-clockwise corners)
+    const double m[3] = {f.y * e[2] - f.z * e[1], f.z * e[0] - f.x * e[2], f.x * e[1] - f.y * e[0]};
+    inside[k] = len > 0
+                    ? ((q[0] - p0[0]) * m[0] + (q[1] - p0[1]) * m[1] + (q[2] - p0[2]) * m[2]) / len
+                    : 0.0;
+  }
+  // beside an edge: within the contact's depth of it, or 1 % of the triangle's size
+  const double near = std::max(std::abs(c.depth), 0.01 * longest);
+  for (int k = 0; k < 3; ++k) {
+    // beyond a smooth edge lies the next triangle, within kSmoothEdgeAngle of this one (ODE
+    // places some contacts just past their triangle); farther than this triangle's size is
+    // beyond what this triangle tells
+    if (inside[k] < -longest) return false;
+    if (inside[k] < near && !edges.smooth(triangle, k)) return false;
+    // corner k + 1 joins edges k and k + 1
+    const int k1 = (k + 1) % 3;
+    if (inside[k] < near && inside[k1] < near && !edges.smoothCorner(triangle, k1)) return false;
+  }
+  // depth: the partner's penetration below the triangle's plane
+  double depth = std::max(-dist, std::abs(c.depth) * std::max(0.0, cos_f));
+  if (dGeomGetClass(partner) == dTriMeshClass) {
+    const int other = fixture_is_g2 ? c.side1 : c.side2;
+    if (other >= 0 && other < dGeomTriMeshGetTriangleCount(partner)) {
+      dVector3 pa, pb, pc;
+      dGeomTriMeshGetTriangle(partner, other, &pa, &pb, &pc);
+      for (const dReal* p : {static_cast<const dReal*>(pa), static_cast<const dReal*>(pb),
+                             static_cast<const dReal*>(pc)}) {
+        depth = std::max(depth, -((p[0] - v[0]) * f.x + (p[1] - v[1]) * f.y + (p[2] - v[2]) * f.z));
+      }
     }
   }
-  if (!have) return false;
-  c.normal[0] = best_n[0];
-  c.normal[1] = best_n[1];
-  c.normal[2] = best_n[2];
-  c.depth = best_depth;
+  c.normal[0] = sign * f.x;
+  c.normal[1] = sign * f.y;
+  c.normal[2] = sign * f.z;
+  c.depth = std::max(0.0, depth);
   return true;
 }
 
@@ -423,7 +479,7 @@ class TrimeshCullingMessageFilter {
 /// dCollide(o1, o2, max, out, stride) where neither geom is a triangle mesh; for a pair with
 /// one, every contact ODE finds, reduced to at most `max` that span the set (file comment).
 /// `max` >= 1 and `out` room for `max` records of `stride` bytes, as dCollide. `scratch` is
-/// the caller's buffer, reused between calls. Returns the number of contacts written. While it
+/// the caller's memory, reused between calls. Returns the number of contacts written. While it
 /// collides a mesh pair, ODE's message handler is replaced by one that drops the trimesh-trimesh
 /// culling warning (detail::dropTrimeshCullingMessage) and forwards every other message.
 inline int collideSpanning(dGeomID o1, dGeomID o2, int max, dContactGeom* out, int stride,
@@ -443,13 +499,27 @@ inline int collideSpanning(dGeomID o1, dGeomID o2, int max, dContactGeom* out, i
   int capacity = std::max(kMeshContactCapacity, max);
   int n = 0, previous = -1;
   const detail::TrimeshCullingMessageFilter filter;
-  // ODE's trimesh-trimesh test merges contacts found at one point on several triangles and,
-  // without a merge callback, forgets both triangles (side -1), which the normal correction
-  // needs: a mesh without one gets detail::keepFirstTriangle (a contact on a mesh seam lies on
-  // both of its triangles; at a sharp edge, either of them finds that edge).
-  for (const dGeomID g : {o1, o2}) {
-    if (dGeomGetClass(g) == dTriMeshClass && dGeomTriMeshGetTriMergeCallback(g) == nullptr) {
-      dGeomTriMeshSetTriMergeCallback(g, &detail::keepFirstTriangle);
+  // The fixture meshes of the pair, whose normals are corrected (file comment); their edge tables
+  // are looked up once per call.
+  dGeomID fixtures[2] = {nullptr, nullptr};
+  const MeshEdges* fixture_edges[2] = {nullptr, nullptr};
+  for (int i = 0; i < 2; ++i) {
+    const dGeomID g = i == 0 ? o1 : o2;
+    if (dGeomGetClass(g) == dTriMeshClass && scratch.fixture(g)) {
+      fixtures[i] = g;
+      fixture_edges[i] = &scratch.edgesOf(g);
+    }
+  }
+  // ODE's trimesh-trimesh test merges contacts found at one point on two triangles (depths
+  // within its epsilon, normals averaged) and, without a merge callback, forgets the triangle
+  // (side -1). For the call, a fixture without one gets detail::keepFirstTriangle, so that such
+  // a contact on a seam can be corrected (it lies on both triangles; at a sharp edge or corner
+  // either finds it); the callback is removed again after the call.
+  bool merge_callback_set[2] = {false, false};
+  for (int i = 0; i < 2; ++i) {
+    if (fixtures[i] && dGeomTriMeshGetTriMergeCallback(fixtures[i]) == nullptr) {
+      dGeomTriMeshSetTriMergeCallback(fixtures[i], &detail::keepFirstTriangle);
+      merge_callback_set[i] = true;
     }
   }
   while (true) {
@@ -460,9 +530,19 @@ inline int collideSpanning(dGeomID o1, dGeomID o2, int max, dContactGeom* out, i
     previous = n;
     capacity = std::min(2 * capacity, kMeshContactCapacityLimit);
   }
+  for (int i = 0; i < 2; ++i) {
+    if (merge_callback_set[i]) dGeomTriMeshSetTriMergeCallback(fixtures[i], nullptr);
+  }
   if (n <= 0) return 0;
   scratch.contacts.resize(static_cast<std::size_t>(n));
-  for (dContactGeom& c : scratch.contacts) detail::correctInternalEdgeNormal(c, scratch);
+  for (dContactGeom& c : scratch.contacts) {
+    for (int i = 0; i < 2; ++i) {
+      if (fixtures[i] && (c.g1 == fixtures[i] || c.g2 == fixtures[i]) &&
+          detail::correctInternalEdgeNormal(c, fixtures[i], *fixture_edges[i])) {
+        break;
+      }
+    }
+  }
   return detail::keepSpanningContacts(scratch.contacts, max, out, stride);
 }
 
