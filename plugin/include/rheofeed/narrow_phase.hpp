@@ -40,11 +40,10 @@
 /// fixture, is more than kFaceNormalTolerance from the face normal of the fixture's triangle, at a
 /// point over that triangle whose nearby edges and corners are all smooth (MeshEdges: the surface
 /// continues across them within kSmoothEdgeAngle), gets the triangle's face normal; its depth is
-/// the partner's penetration below the triangle's plane (the deepest corner of a mesh partner's
-/// triangle, else the contact point's depth, and at least ODE's depth times the cosine between
-/// the two normals). Contacts at a sharp edge or corner (a rim, the corner of floor and wall, the
-/// mesh's border), beside the triangle, on merged contacts whose triangle ODE forgot, and with
-/// convex geoms (whose triangle index ODE does not give; ODE corrects those itself) keep ODE's
+/// how far its point lies below the triangle's plane, and at least ODE's depth times the cosine
+/// between the two normals. Contacts at a sharp edge or corner (a rim, the corner of floor and
+/// wall, the mesh's border), beside the triangle, on merged contacts whose triangle ODE forgot, and
+/// with convex geoms (whose triangle index ODE does not give; ODE corrects those itself) keep ODE's
 /// normal. A mesh nut on a belt of 1 mm triangles at h = 0.01 s was carried at 65 % of the belt's
 /// speed with ODE's normals (Plugin.NarrowPhase.MeshNutOnATessellatedBeltIsCarriedAtTheBeltSpeed);
 /// the mesh bowl: demos/results/bowl_feeder.md, section 9.
@@ -413,19 +412,12 @@ inline bool correctInternalEdgeNormal(dContactGeom& c, dGeomID fixture, const Me
     const int k1 = (k + 1) % 3;
     if (inside[k] < near && inside[k1] < near && !edges.smoothCorner(triangle, k1)) return false;
   }
-  // depth: the partner's penetration below the triangle's plane
-  double depth = std::max(-dist, std::abs(c.depth) * std::max(0.0, cos_f));
-  if (dGeomGetClass(partner) == dTriMeshClass) {
-    const int other = fixture_is_g2 ? c.side1 : c.side2;
-    if (other >= 0 && other < dGeomTriMeshGetTriangleCount(partner)) {
-      dVector3 pa, pb, pc;
-      dGeomTriMeshGetTriangle(partner, other, &pa, &pb, &pc);
-      for (const dReal* p : {static_cast<const dReal*>(pa), static_cast<const dReal*>(pb),
-                             static_cast<const dReal*>(pc)}) {
-        depth = std::max(depth, -((p[0] - v[0]) * f.x + (p[1] - v[1]) * f.y + (p[2] - v[2]) * f.z));
-      }
-    }
-  }
+  // depth: how far the contact point lies below the triangle's plane, and at least ODE's depth
+  // projected on the new normal. Not a mesh partner's deepest corner: its triangle reaches past
+  // this one, and on a curved fixture (the bowl's 4 degree cone) that corner lies below this
+  // triangle's plane where the fixture does not; that depth pushed a flat nut up every step and
+  // made it hop (demos/results/bowl_feeder.md, section 9).
+  const double depth = std::max(-dist, std::abs(c.depth) * std::max(0.0, cos_f));
   c.normal[0] = sign * f.x;
   c.normal[1] = sign * f.y;
   c.normal[2] = sign * f.z;
