@@ -37,16 +37,17 @@
 /// fixture meshes are corrected (MeshCollisionScratch::is_fixture: by default a geom without a
 /// body or with a kinematic one): a fixture is locally a plane wherever its surface is smooth,
 /// and the contact normal of a plane is its own. A contact whose normal, turned out of the
-/// fixture, is more than kFaceNormalTolerance from the face normal of the fixture's triangle, at a
-/// point over that triangle whose nearby edges and corners are all smooth (MeshEdges: the surface
-/// continues across them within kSmoothEdgeAngle), gets the triangle's face normal; its depth is
-/// how far its point lies below the triangle's plane, and at least ODE's depth times the cosine
-/// between the two normals. Contacts at a sharp edge or corner (a rim, the corner of floor and
-/// wall, the mesh's border), beside the triangle, on merged contacts whose triangle ODE forgot, and
-/// with convex geoms (whose triangle index ODE does not give; ODE corrects those itself) keep ODE's
-/// normal. A mesh nut on a belt of 1 mm triangles at h = 0.01 s was carried at 65 % of the belt's
-/// speed with ODE's normals (Plugin.NarrowPhase.MeshNutOnATessellatedBeltIsCarriedAtTheBeltSpeed);
-/// the mesh bowl: demos/results/bowl_feeder.md, section 9.
+/// fixture, is more than kFaceNormalTolerance from the face normal of the fixture's triangle (and
+/// not pointing into it), at a point over that triangle, or over a neighbour reached across its
+/// smooth edges, away from sharp edges and corners (MeshEdges: the surface continues across an
+/// edge within kSmoothEdgeAngle), gets that triangle's face normal; its depth is how far its point
+/// lies below the face, and at least ODE's depth times the cosine between the two normals.
+/// Contacts at a sharp edge or corner (a rim, the corner of floor and wall, the mesh's border),
+/// off the mesh's smooth surface, of spheres (whose contacts have a face's normal) and of convex
+/// geoms (whose triangle ODE does not give; ODE corrects those itself) keep ODE's normal. A mesh
+/// nut on a belt of 1 mm triangles at h = 0.01 s was carried at 65 % of the belt's speed with
+/// ODE's normals (Plugin.NarrowPhase.MeshNutOnATessellatedBeltIsCarriedAtTheBeltSpeed); the mesh
+/// bowl: demos/results/bowl_feeder.md, section 9.
 ///
 /// Header only: the plugin's ContactCollider and the reference world (which does not link the
 /// plugin library) both use it.
@@ -97,6 +98,7 @@ class MeshEdges {
     triangles_ = n > 0 ? n : 0;
     fingerprint_ = fingerprintOf(mesh, triangles_);
     smooth_.assign(static_cast<std::size_t>(triangles_), 0);
+    neighbour_.assign(3 * static_cast<std::size_t>(triangles_), -1);
     if (triangles_ == 0) return;
     std::vector<double> v(9 * static_cast<std::size_t>(triangles_));
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
@@ -177,8 +179,11 @@ class MeshEdges {
         sharp_vertex[static_cast<std::size_t>(sides[0].to)] = 1;
         continue;
       }
-      for (const Side& sd : sides) {
+      for (int i = 0; i < 2; ++i) {
+        const Side& sd = sides[static_cast<std::size_t>(i)];
         smooth_[static_cast<std::size_t>(sd.triangle)] |= static_cast<std::uint8_t>(1u << sd.edge);
+        neighbour_[3 * static_cast<std::size_t>(sd.triangle) + static_cast<std::size_t>(sd.edge)] =
+            sides[static_cast<std::size_t>(1 - i)].triangle;
       }
     }
     for (int t = 0; t < triangles_; ++t) {
@@ -219,6 +224,13 @@ class MeshEdges {
   bool smoothCorner(int triangle, int corner) const {
     if (triangle < 0 || triangle >= triangles_ || corner < 0 || corner > 2) return false;
     return (smooth_[static_cast<std::size_t>(triangle)] >> (3 + corner)) & 1u;
+  }
+
+  /// The triangle across smooth edge `edge` of triangle `triangle`; -1 across a sharp edge or for
+  /// an index out of range.
+  int neighbour(int triangle, int edge) const {
+    if (triangle < 0 || triangle >= triangles_ || edge < 0 || edge > 2) return -1;
+    return neighbour_[3 * static_cast<std::size_t>(triangle) + static_cast<std::size_t>(edge)];
   }
 
   int triangles() const { return triangles_; }
@@ -268,11 +280,12 @@ class MeshEdges {
   int triangles_ = 0;
   Fingerprint fingerprint_;
   std::vector<std::uint8_t> smooth_;  // bit k: edge k is smooth; bit 3 + k: corner k is
+  std::vector<int> neighbour_;        // 3 per triangle: across each smooth edge, else -1
 };
 
 /// collideSpanning's working memory, kept by the caller between calls: the contact buffer, and
-/// the edge tables of the meshes met (built on first contact, rebuilt if a mesh's address is
-/// reused for another).
+/// the edge tables of the fixture meshes met (built on the first call that collides one, rebuilt
+/// when a mesh data's address is reused for another; never dropped).
 struct MeshCollisionScratch {
   std::vector<dContactGeom> contacts;
   std::unordered_map<dTriMeshDataID, MeshEdges> edges;
@@ -359,12 +372,34 @@ inline int keepFirstTriangle(dGeomID, int first, int) {
   return first;
 }
 
+/// Sets detail::keepFirstTriangle as `mesh`'s merge callback for its lifetime (one collideSpanning
+/// call) when the mesh has none, and removes it again, exceptions included.
+class MergeCallbackScope {
+ public:
+  MergeCallbackScope() = default;
+  void set(dGeomID mesh) {
+    if (dGeomTriMeshGetTriMergeCallback(mesh) != nullptr) return;  // the user's own: left alone
+    dGeomTriMeshSetTriMergeCallback(mesh, &keepFirstTriangle);
+    meshes_[count_++] = mesh;
+  }
+  ~MergeCallbackScope() {
+    for (int i = 0; i < count_; ++i) dGeomTriMeshSetTriMergeCallback(meshes_[i], nullptr);
+  }
+  MergeCallbackScope(const MergeCallbackScope&) = delete;
+  MergeCallbackScope& operator=(const MergeCallbackScope&) = delete;
+
+ private:
+  dGeomID meshes_[2] = {nullptr, nullptr};
+  int count_ = 0;
+};
+
 /// Partner classes whose contacts with a mesh name the mesh's triangle in side1 / side2 (ODE
-/// 0.16.2); the convex-trimesh collider gives a position in its own list instead.
+/// 0.16.2) and may carry a seam's normal; the convex-trimesh collider gives a position in its own
+/// list instead, and a sphere's contacts already have a face's normal (merged ones, when a user
+/// turns merging on, an average ODE means to keep).
 inline bool namesTheTriangle(dGeomID partner) {
   const int c = dGeomGetClass(partner);
-  return c == dTriMeshClass || c == dBoxClass || c == dSphereClass || c == dCapsuleClass ||
-         c == dCylinderClass;
+  return c == dTriMeshClass || c == dBoxClass || c == dCapsuleClass || c == dCylinderClass;
 }
 
 /// The internal-edge correction of the file comment for contact c, whose fixture mesh is
@@ -374,43 +409,65 @@ inline bool correctInternalEdgeNormal(dContactGeom& c, dGeomID fixture, const Me
   const int triangle = fixture_is_g2 ? c.side2 : c.side1;
   const dGeomID partner = fixture_is_g2 ? c.g1 : c.g2;
   if (triangle < 0 || triangle >= edges.triangles() || !namesTheTriangle(partner)) return false;
-  dVector3 a, b, cc;
-  dGeomTriMeshGetTriangle(fixture, triangle, &a, &b, &cc);
-  const double v[9] = {a[0], a[1], a[2], b[0], b[1], b[2], cc[0], cc[1], cc[2]};
-  const MeshEdges::Normal f = MeshEdges::faceNormal(v);
-  if (!f.valid) return false;
-  // ODE's normal points out of g2 into g1: turned out of the fixture
-  const double sign = fixture_is_g2 ? 1.0 : -1.0;
-  const double cos_f = sign * (c.normal[0] * f.x + c.normal[1] * f.y + c.normal[2] * f.z);
-  // the face's own normal (to rounding): nothing to correct
-  if (cos_f >= std::cos(kFaceNormalTolerance * 3.14159265358979323846 / 180.0)) return false;
-  // where the contact lies over the triangle: signed distances to its edges, inwards
-  const double dist = (c.pos[0] - v[0]) * f.x + (c.pos[1] - v[1]) * f.y + (c.pos[2] - v[2]) * f.z;
-  const double q[3] = {c.pos[0] - dist * f.x, c.pos[1] - dist * f.y, c.pos[2] - dist * f.z};
-  double longest = 0, inside[3];
-  for (int k = 0; k < 3; ++k) {
-    const double* p0 = v + 3 * k;
-    const double* p1 = v + 3 * ((k + 1) % 3);
-    const double e[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-    const double len = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-    longest = std::max(longest, len);
-    // f x e / |e|: the edge's in-plane normal, into the triangle (counter-clockwise corners)
-    const double m[3] = {f.y * e[2] - f.z * e[1], f.z * e[0] - f.x * e[2], f.x * e[1] - f.y * e[0]};
-    inside[k] = len > 0
-                    ? ((q[0] - p0[0]) * m[0] + (q[1] - p0[1]) * m[1] + (q[2] - p0[2]) * m[2]) / len
-                    : 0.0;
-  }
-  // beside an edge: within the contact's depth of it, or 1 % of the triangle's size
-  const double near = std::max(std::abs(c.depth), 0.01 * longest);
-  for (int k = 0; k < 3; ++k) {
-    // beyond a smooth edge lies the next triangle, within kSmoothEdgeAngle of this one (ODE
-    // places some contacts just past their triangle); farther than this triangle's size is
-    // beyond what this triangle tells
-    if (inside[k] < -longest) return false;
-    if (inside[k] < near && !edges.smooth(triangle, k)) return false;
-    // corner k + 1 joins edges k and k + 1
-    const int k1 = (k + 1) % 3;
-    if (inside[k] < near && inside[k1] < near && !edges.smoothCorner(triangle, k1)) return false;
+  // The triangle the contact lies over: ODE names one, and places some contacts just past it (a
+  // merged contact, a cylinder's rim over the next cell); across a smooth edge the walk goes on to
+  // the neighbour, at most kMaxWalk triangles. The contact is corrected when it lies over a
+  // triangle away from its sharp edges and corners.
+  constexpr int kMaxWalk = 4;
+  int t = triangle;
+  double v[9];
+  MeshEdges::Normal f;
+  double dist = 0, cos_f = 0;
+  const double sign = fixture_is_g2 ? 1.0 : -1.0;  // ODE's normal points out of g2 into g1
+  for (int walk = 0;; ++walk) {
+    dVector3 a, b, cc;
+    dGeomTriMeshGetTriangle(fixture, t, &a, &b, &cc);
+    const double corners[9] = {a[0], a[1], a[2], b[0], b[1], b[2], cc[0], cc[1], cc[2]};
+    std::copy(corners, corners + 9, v);
+    f = MeshEdges::faceNormal(v);
+    if (!f.valid) return false;
+    // ODE's normal turned out of the fixture, against this face's
+    cos_f = sign * (c.normal[0] * f.x + c.normal[1] * f.y + c.normal[2] * f.z);
+    if (walk == 0 && cos_f >= std::cos(kFaceNormalTolerance * 3.14159265358979323846 / 180.0)) {
+      return false;  // the face's own normal (to rounding): nothing to correct
+    }
+    // a normal pointing into the face is a contact from the other side of a thin wall, not a seam
+    if (cos_f < -0.5) return false;
+    dist = (c.pos[0] - v[0]) * f.x + (c.pos[1] - v[1]) * f.y + (c.pos[2] - v[2]) * f.z;
+    const double q[3] = {c.pos[0] - dist * f.x, c.pos[1] - dist * f.y, c.pos[2] - dist * f.z};
+    double longest = 0, inside[3];
+    for (int k = 0; k < 3; ++k) {
+      const double* p0 = v + 3 * k;
+      const double* p1 = v + 3 * ((k + 1) % 3);
+      const double e[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+      const double len = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+      longest = std::max(longest, len);
+      // f x e / |e|: the edge's in-plane normal, into the triangle (counter-clockwise corners)
+      const double m[3] = {f.y * e[2] - f.z * e[1], f.z * e[0] - f.x * e[2],
+                           f.x * e[1] - f.y * e[0]};
+      inside[k] =
+          len > 0 ? ((q[0] - p0[0]) * m[0] + (q[1] - p0[1]) * m[1] + (q[2] - p0[2]) * m[2]) / len
+                  : 0.0;
+    }
+    // beside an edge: within the contact's depth of it, or 1 % of the triangle's size
+    const double near = std::max(std::abs(c.depth), 0.01 * longest);
+    int beyond = -1;  // the edge the point lies farthest beyond, when it is off this triangle
+    for (int k = 0; k < 3; ++k) {
+      if (inside[k] < -near && (beyond < 0 || inside[k] < inside[beyond])) beyond = k;
+    }
+    if (beyond >= 0) {
+      const int next = edges.neighbour(t, beyond);
+      if (next < 0 || walk + 1 >= kMaxWalk) return false;  // off the mesh's smooth surface
+      t = next;
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (inside[k] < near && !edges.smooth(t, k)) return false;
+      // corner k + 1 joins edges k and k + 1
+      const int k1 = (k + 1) % 3;
+      if (inside[k] < near && inside[k1] < near && !edges.smoothCorner(t, k1)) return false;
+    }
+    break;
   }
   // depth: how far the contact point lies below the triangle's plane, and at least ODE's depth
   // projected on the new normal. Not a mesh partner's deepest corner: its triangle reaches past
@@ -507,12 +564,10 @@ inline int collideSpanning(dGeomID o1, dGeomID o2, int max, dContactGeom* out, i
   // (side -1). For the call, a fixture without one gets detail::keepFirstTriangle, so that such
   // a contact on a seam can be corrected (it lies on both triangles; at a sharp edge or corner
   // either finds it); the callback is removed again after the call.
-  bool merge_callback_set[2] = {false, false};
+  detail::MergeCallbackScope merge_callbacks;
   for (int i = 0; i < 2; ++i) {
-    if (fixtures[i] && dGeomTriMeshGetTriMergeCallback(fixtures[i]) == nullptr) {
-      dGeomTriMeshSetTriMergeCallback(fixtures[i], &detail::keepFirstTriangle);
-      merge_callback_set[i] = true;
-    }
+    const dGeomID other = i == 0 ? o2 : o1;
+    if (fixtures[i] && dGeomGetClass(other) == dTriMeshClass) merge_callbacks.set(fixtures[i]);
   }
   while (true) {
     scratch.contacts.resize(static_cast<std::size_t>(capacity));
@@ -521,9 +576,6 @@ inline int collideSpanning(dGeomID o1, dGeomID o2, int max, dContactGeom* out, i
     if (n < capacity && !(merges && n != previous)) break;
     previous = n;
     capacity = std::min(2 * capacity, kMeshContactCapacityLimit);
-  }
-  for (int i = 0; i < 2; ++i) {
-    if (merge_callback_set[i]) dGeomTriMeshSetTriMergeCallback(fixtures[i], nullptr);
   }
   if (n <= 0) return 0;
   scratch.contacts.resize(static_cast<std::size_t>(n));
