@@ -56,6 +56,7 @@
 #include <ode/ode.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdarg>
 #include <cstddef>
@@ -63,9 +64,12 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <map>
 #include <tuple>
 #include <unordered_map>
 #include <vector>
+
+#include "rheofeed/vec3.hpp"
 
 namespace rheofeed {
 
@@ -84,6 +88,11 @@ inline constexpr double kSmoothEdgeAngle = 10.0;
 /// normal (rounding): any other, averaged ones included, is a candidate for the correction.
 inline constexpr double kFaceNormalTolerance = 0.1;
 
+namespace detail {
+inline const double kCosSmoothEdgeAngle = std::cos(kSmoothEdgeAngle * kPi / 180.0);
+inline const double kCosFaceNormalTolerance = std::cos(kFaceNormalTolerance * kPi / 180.0);
+}  // namespace detail
+
 /// For each triangle edge of one triangle mesh (ODE's geom), whether the surface continues
 /// smoothly across it (kSmoothEdgeAngle; consistent winding, exactly two triangles on the edge),
 /// and for each corner whether every edge at its vertex does. Vertices are matched by position
@@ -97,7 +106,7 @@ class MeshEdges {
     const int n = dGeomTriMeshGetTriangleCount(mesh);
     triangles_ = n > 0 ? n : 0;
     fingerprint_ = fingerprintOf(mesh, triangles_);
-    smooth_.assign(static_cast<std::size_t>(triangles_), 0);
+    smooth_corner_.assign(static_cast<std::size_t>(triangles_), 0);
     neighbour_.assign(3 * static_cast<std::size_t>(triangles_), -1);
     if (triangles_ == 0) return;
     std::vector<double> v(9 * static_cast<std::size_t>(triangles_));
@@ -120,34 +129,17 @@ class MeshEdges {
         std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                   (hi[2] - lo[2]) * (hi[2] - lo[2]));
     const double q = size > 0 && std::isfinite(size) ? 1e-7 * size : 1.0;
-    // vertex ids by quantised position
-    struct Vertex {
-      std::int64_t key[3];
-      int id;
-    };
-    std::unordered_map<std::uint64_t, std::vector<Vertex>> cells;
+    // vertex ids by quantised position, in order of first appearance
+    std::map<std::array<std::int64_t, 3>, int> ids;
     std::vector<int> id(3 * static_cast<std::size_t>(triangles_));
-    int next_id = 0;
     for (std::size_t i = 0; i < id.size(); ++i) {
-      std::int64_t key3[3];
-      for (int d = 0; d < 3; ++d) {
-        key3[d] = static_cast<std::int64_t>(
-            std::llround((v[3 * i + static_cast<std::size_t>(d)] - lo[d]) / q));
+      std::array<std::int64_t, 3> key{};
+      for (std::size_t d = 0; d < 3; ++d) {
+        key[d] = static_cast<std::int64_t>(std::llround((v[3 * i + d] - lo[d]) / q));
       }
-      const std::uint64_t h = static_cast<std::uint64_t>(key3[0]) * 73856093u ^
-                              static_cast<std::uint64_t>(key3[1]) * 19349663u ^
-                              static_cast<std::uint64_t>(key3[2]) * 83492791u;
-      std::vector<Vertex>& bucket = cells[h];
-      int found = -1;
-      for (const Vertex& e : bucket) {
-        if (e.key[0] == key3[0] && e.key[1] == key3[1] && e.key[2] == key3[2]) found = e.id;
-      }
-      if (found < 0) {
-        found = next_id++;
-        bucket.push_back({{key3[0], key3[1], key3[2]}, found});
-      }
-      id[i] = found;
+      id[i] = ids.emplace(key, static_cast<int>(ids.size())).first->second;
     }
+    const int next_id = static_cast<int>(ids.size());
     // edges: directed (from, to) -> triangle and edge index
     struct Side {
       int triangle, edge, from, to;
@@ -163,7 +155,6 @@ class MeshEdges {
         edges[key].push_back({t, k, a, b});
       }
     }
-    const double cos_smooth = std::cos(kSmoothEdgeAngle * 3.14159265358979323846 / 180.0);
     // a corner is smooth when every edge at its vertex is (and it has edges: not a lone point)
     std::vector<std::uint8_t> sharp_vertex(static_cast<std::size_t>(next_id), 0);
     for (const auto& entry : edges) {
@@ -172,7 +163,8 @@ class MeshEdges {
       if (smooth) {
         const Normal n0 = faceNormal(&v[9 * static_cast<std::size_t>(sides[0].triangle)]);
         const Normal n1 = faceNormal(&v[9 * static_cast<std::size_t>(sides[1].triangle)]);
-        smooth = n0.valid && n1.valid && n0.x * n1.x + n0.y * n1.y + n0.z * n1.z >= cos_smooth;
+        smooth = n0.valid && n1.valid &&
+                 n0.x * n1.x + n0.y * n1.y + n0.z * n1.z >= detail::kCosSmoothEdgeAngle;
       }
       if (!smooth) {
         sharp_vertex[static_cast<std::size_t>(sides[0].from)] = 1;
@@ -181,7 +173,6 @@ class MeshEdges {
       }
       for (int i = 0; i < 2; ++i) {
         const Side& sd = sides[static_cast<std::size_t>(i)];
-        smooth_[static_cast<std::size_t>(sd.triangle)] |= static_cast<std::uint8_t>(1u << sd.edge);
         neighbour_[3 * static_cast<std::size_t>(sd.triangle) + static_cast<std::size_t>(sd.edge)] =
             sides[static_cast<std::size_t>(1 - i)].triangle;
       }
@@ -190,7 +181,7 @@ class MeshEdges {
       for (int k = 0; k < 3; ++k) {
         const int vertex = id[3 * static_cast<std::size_t>(t) + static_cast<std::size_t>(k)];
         if (!sharp_vertex[static_cast<std::size_t>(vertex)]) {
-          smooth_[static_cast<std::size_t>(t)] |= static_cast<std::uint8_t>(1u << (3 + k));
+          smooth_corner_[static_cast<std::size_t>(t)] |= static_cast<std::uint8_t>(1u << k);
         }
       }
     }
@@ -214,16 +205,13 @@ class MeshEdges {
 
   /// Whether the surface continues smoothly across edge `edge` (0: corner 0 to 1, 1: 1 to 2,
   /// 2: 2 to 0) of triangle `triangle`; false for an index out of range.
-  bool smooth(int triangle, int edge) const {
-    if (triangle < 0 || triangle >= triangles_ || edge < 0 || edge > 2) return false;
-    return (smooth_[static_cast<std::size_t>(triangle)] >> edge) & 1u;
-  }
+  bool smooth(int triangle, int edge) const { return neighbour(triangle, edge) >= 0; }
 
   /// Whether the surface is smooth all round corner `corner` (0, 1, 2) of triangle `triangle`:
   /// every edge at that vertex is smooth; false for an index out of range.
   bool smoothCorner(int triangle, int corner) const {
     if (triangle < 0 || triangle >= triangles_ || corner < 0 || corner > 2) return false;
-    return (smooth_[static_cast<std::size_t>(triangle)] >> (3 + corner)) & 1u;
+    return (smooth_corner_[static_cast<std::size_t>(triangle)] >> corner) & 1u;
   }
 
   /// The triangle across smooth edge `edge` of triangle `triangle`; -1 across a sharp edge or for
@@ -279,8 +267,8 @@ class MeshEdges {
 
   int triangles_ = 0;
   Fingerprint fingerprint_;
-  std::vector<std::uint8_t> smooth_;  // bit k: edge k is smooth; bit 3 + k: corner k is
-  std::vector<int> neighbour_;        // 3 per triangle: across each smooth edge, else -1
+  std::vector<std::uint8_t> smooth_corner_;  // bit k: corner k is smooth
+  std::vector<int> neighbour_;  // 3 per triangle: the triangle across each smooth edge, else -1
 };
 
 /// collideSpanning's working memory, kept by the caller between calls: the contact buffer, and
@@ -428,7 +416,7 @@ inline bool correctInternalEdgeNormal(dContactGeom& c, dGeomID fixture, const Me
     if (!f.valid) return false;
     // ODE's normal turned out of the fixture, against this face's
     cos_f = sign * (c.normal[0] * f.x + c.normal[1] * f.y + c.normal[2] * f.z);
-    if (walk == 0 && cos_f >= std::cos(kFaceNormalTolerance * 3.14159265358979323846 / 180.0)) {
+    if (walk == 0 && cos_f >= detail::kCosFaceNormalTolerance) {
       return false;  // the face's own normal (to rounding): nothing to correct
     }
     // a normal pointing into the face is a contact from the other side of a thin wall, not a seam

@@ -232,7 +232,10 @@ struct WorldState {
     const int max = settings.max_contacts_per_pair;
     scratch.resize(static_cast<std::size_t>(max));
     // the reference world's geoms carry no ODE bodies: a fixture is a geom of no dynamic body
-    mesh_scratch.is_fixture = [this](dGeomID g) { return !isDynamic(bodyOf(g)); };
+    // (set once: this state is created in place and never moved)
+    if (!mesh_scratch.is_fixture) {
+      mesh_scratch.is_fixture = [this](dGeomID g) { return !isDynamic(bodyOf(g)); };
+    }
     const int n =
         rheofeed::collideSpanning(o1, o2, max, scratch.data(), sizeof(dContactGeom), mesh_scratch);
     if (n <= 0) return;
