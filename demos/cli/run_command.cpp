@@ -295,10 +295,12 @@ int runCommand(const RunArgs& args) {
       if (recorder) recorder->write(out / (toString(m) + std::string(".glb")));
       blocks.emplace_back(toString(m), seriesCsv(r));
       const RunHealth& h = r.health;
-      std::printf("| %s | %.3g | %d | %.5f | %.5f | %.4f | %.2f | %.2f | %.4f | %d | %.1f %% |\n",
-                  toString(m), r.time_step, r.parts, r.mean_drift, r.mean_drift_ci95,
-                  r.vertical_displacement, r.throughput, r.cpu_seconds, r.real_time_factor,
-                  h.partsLost(), 100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps));
+      char ci[32] = "n/a";  // no confidence interval over fewer than two parts
+      if (r.parts >= 2) std::snprintf(ci, sizeof ci, "%.5f", r.mean_drift_ci95);
+      std::printf("| %s | %.3g | %d | %.5f | %s | %.4f | %.2f | %.2f | %.4f | %d | %.1f %% |\n",
+                  toString(m), r.time_step, r.parts, r.mean_drift, ci, r.vertical_displacement,
+                  r.throughput, r.cpu_seconds, r.real_time_factor, h.partsLost(),
+                  100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps));
       std::fflush(stdout);
     }
     if (blocks.size() > 1) {

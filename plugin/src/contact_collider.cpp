@@ -76,6 +76,7 @@ void ContactCollider::clearJoints() {
   feedback_used_ = 0;
   speculative_count_ = 0;
   warm_started_count_ = 0;
+  resting_count_ = 0;
 }
 
 void ContactCollider::rethrowPendingError() {
@@ -90,6 +91,14 @@ void ContactCollider::collide(dSpaceID space, double time, double step) {
   feeders_.beginStep(time, step);  // first: a refused time or step leaves everything as it was
   if (settings_.warm_start) keepWarmStarts();
   clearJoints();
+  step_ = step;
+  resting_.swap(resting_next_);
+  resting_next_.clear();
+  std::stable_sort(resting_.begin(), resting_.end(),
+                   [](const RestingPoint& x, const RestingPoint& y) {
+                     return std::less<dGeomID>()(x.part, y.part) ||
+                            (x.part == y.part && std::less<dGeomID>()(x.fixture, y.fixture));
+                   });
   const bool speculative = settings_.speculative && step > 0;
   if (speculative) {
     try {
@@ -168,6 +177,8 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
   dContact* contacts = buffer_.data();
   int n = collideSpanning(o1, o2, settings_.max_contacts_per_pair, &contacts[0].geom,
                           sizeof(dContact), mesh_buffer_);
+  int gaps = 0;
+  if (settings_.speculative && step_ > 0) n = addRestingContacts(o1, o2, contacts, n, gaps);
   if (n <= 0) return;
   if (!sweep_of_geom_.empty()) {  // a swept geom in contact already needs no ray to it
     if (const auto it = sweep_of_geom_.find(o1); it != sweep_of_geom_.end()) {
@@ -177,7 +188,102 @@ void ContactCollider::handlePair(dGeomID o1, dGeomID o2) {
       sweeps_[it->second].touching.push_back(o1);
     }
   }
-  addContacts(o1, o2, contacts, n, nullptr);
+  if (n > gaps) addContacts(o1, o2, contacts, n - gaps, nullptr);
+  if (gaps > 0) {
+    for (double& g : resting_gap_) g /= step_;  // the gap per step (m/s)
+    addContacts(o1, o2, contacts + (n - gaps), gaps, resting_gap_.data());
+  }
+}
+
+namespace {
+double smallestHalfExtent(dGeomID g);
+// Marks a resting candidate (addRestingContacts) in its part-side index until the reduction.
+constexpr int kRestingTag = -2;
+}  // namespace
+
+int ContactCollider::addRestingContacts(dGeomID o1, dGeomID o2, dContact* contacts, int n,
+                                        int& gaps) {
+  gaps = 0;
+  if (dGeomGetClass(o1) != dTriMeshClass || dGeomGetClass(o2) != dTriMeshClass) return n;
+  dGeomID part = nullptr, fixture = nullptr;
+  for (int k = 0; k < 2 && !part; ++k) {
+    const dGeomID a = k == 0 ? o1 : o2, b = k == 0 ? o2 : o1;
+    const dBodyID body = dGeomGetBody(a);
+    if (body && !dBodyIsKinematic(body) && mesh_buffer_.fixture(b)) part = a, fixture = b;
+  }
+  if (!part) return n;
+  const bool fixture_is_g2 = fixture == o2;
+  const double out_sign = fixture_is_g2 ? 1.0 : -1.0;  // ODE's normal: out of g2 into g1
+  const MeshEdges& edges = mesh_buffer_.edgesOf(fixture);
+  const dBodyID body = dGeomGetBody(part);
+  const dReal* x = dBodyGetPosition(body);
+  const dReal* r = dBodyGetRotation(body);  // row-major 3x4
+  // Candidates: this pass's contacts, then the previous pass's points of the pair that are
+  // still over the fixture's smooth surface within `margin` of it (above or below).
+  resting_candidates_.assign(n, dContactGeom{});
+  for (int i = 0; i < n; ++i) resting_candidates_[static_cast<std::size_t>(i)] = contacts[i].geom;
+  const double margin = settings_.speculative_fraction * smallestHalfExtent(part);
+  const auto first = std::lower_bound(
+      resting_.begin(), resting_.end(), std::make_pair(part, fixture),
+      [](const RestingPoint& p, const std::pair<dGeomID, dGeomID>& key) {
+        return std::less<dGeomID>()(p.part, key.first) ||
+               (p.part == key.first && std::less<dGeomID>()(p.fixture, key.second));
+      });
+  for (auto it = first; it != resting_.end() && it->part == part && it->fixture == fixture; ++it) {
+    const Vec3& l = it->local;
+    const double p[3] = {x[0] + r[0] * l.x + r[1] * l.y + r[2] * l.z,
+                         x[1] + r[4] * l.x + r[5] * l.y + r[6] * l.z,
+                         x[2] + r[8] * l.x + r[9] * l.y + r[10] * l.z};
+    SurfacePoint at;
+    if (!surfacePointOver(fixture, edges, it->triangle, p, at)) continue;
+    if (!(std::abs(at.height) <= margin)) continue;
+    dContactGeom c{};
+    for (int k = 0; k < 3; ++k) {
+      c.pos[k] = p[k] - at.height * at.normal[k];  // on the fixture's face
+      c.normal[k] = out_sign * at.normal[k];
+    }
+    c.depth = -at.height;  // < 0: a gap, made a speculative contact below
+    c.g1 = o1;
+    c.g2 = o2;
+    c.side1 = fixture_is_g2 ? kRestingTag : at.triangle;  // the part's side tags it
+    c.side2 = fixture_is_g2 ? at.triangle : kRestingTag;
+    resting_candidates_.push_back(c);
+  }
+  if (resting_candidates_.size() > static_cast<std::size_t>(n)) {
+    n = detail::keepSpanningContacts(resting_candidates_, settings_.max_contacts_per_pair,
+                                     &contacts[0].geom, sizeof(dContact));
+    // the ones across a gap last, depth 0 and their gap kept (stable: the fixed order stays)
+    std::stable_partition(contacts, contacts + n,
+                          [](const dContact& c) { return !(c.geom.depth < 0); });
+    resting_gap_.clear();
+    for (int i = 0; i < n; ++i) {
+      int& part_side = fixture_is_g2 ? contacts[i].geom.side1 : contacts[i].geom.side2;
+      if (part_side == kRestingTag) {
+        part_side = -1;
+        ++resting_count_;
+      }
+      if (!(contacts[i].geom.depth < 0)) continue;
+      resting_gap_.push_back(-contacts[i].geom.depth);
+      contacts[i].geom.depth = 0;
+      ++gaps;
+    }
+  }
+  // Remember where the part touches the fixture (a gap's point on the part) for the next pass.
+  for (int i = 0; i < n; ++i) {
+    const dContactGeom& c = contacts[i].geom;
+    const int triangle = fixture_is_g2 ? c.side2 : c.side1;
+    if (triangle < 0) continue;
+    const double lift =
+        i >= n - gaps ? resting_gap_[static_cast<std::size_t>(i - (n - gaps))] : 0.0;
+    double d[3];
+    for (int k = 0; k < 3; ++k) d[k] = c.pos[k] + lift * out_sign * c.normal[k] - x[k];
+    resting_next_.push_back(
+        {part, fixture,
+         Vec3{r[0] * d[0] + r[4] * d[1] + r[8] * d[2], r[1] * d[0] + r[5] * d[1] + r[9] * d[2],
+              r[2] * d[0] + r[6] * d[1] + r[10] * d[2]},
+         triangle});
+  }
+  return n;
 }
 
 void ContactCollider::addContacts(dGeomID o1, dGeomID o2, dContact* contacts, int n,

@@ -300,6 +300,30 @@ void addHexPrism(MeshData& mesh) {
   }
 }
 
+// An M6 nut blank with its 6 mm hole, as demos/meshes/hex_nut_m6.obj (generate_meshes.cpp): a
+// profile (hole and hexagon, 5 mm thick) swept through 24 polar angles, the hexagon's corners at
+// multiples of 60 degrees; shared vertices, 192 triangles, counter-clockwise from outside. Each
+// flat face is a fan of 48 thin triangles round the hole.
+void addHoledNut(MeshData& mesh) {
+  constexpr int kAngles = 24;
+  const double h = 0.0025, hole = 0.003;
+  std::array<std::array<int, 4>, kAngles> ring{};
+  for (int j = 0; j < kAngles; ++j) {
+    const double phi = 2 * M_PI * j / kAngles;
+    const double r = 0.005 / std::cos(std::fmod(phi, M_PI / 3) - M_PI / 6);
+    const double c = std::cos(phi), s = std::sin(phi);
+    ring[j] = {mesh.vertex(hole * c, hole * s, -h), mesh.vertex(r * c, r * s, -h),
+               mesh.vertex(r * c, r * s, h), mesh.vertex(hole * c, hole * s, h)};
+  }
+  for (int j = 0; j < kAngles; ++j) {
+    const int k = (j + 1) % kAngles;
+    for (int p = 0; p < 4; ++p) {
+      const int q = (p + 1) % 4;
+      mesh.quad(ring[j][p], ring[k][p], ring[k][q], ring[j][q]);
+    }
+  }
+}
+
 // A body for a mesh nut blank (`nut`, addHexPrism) in `world`: steel, its mass and inertia
 // those of a cylinder of the hexagon's area, lying flat on a floor at z = 0 at (x, y).
 dBodyID addNutBody(dWorldID world, dGeomID nut, double x, double y) {
@@ -354,6 +378,94 @@ TEST(NarrowPhase, MeshEdgesTellTheFloorsSeamsFromItsBorderAndCorners) {
   dSpaceDestroy(space);
 }
 
+// collideSpanning takes dCollide's flags: the low 16 bits are the room in `out`, the high bits
+// options (CONTACTS_UNIMPORTANT). A 1 cm box resting on 1 mm triangles touches dozens of them;
+// it must get at most the count asked for, with CONTACTS_UNIMPORTANT or a high bit set too, and
+// nothing at all (and nothing written) for a count of 0. The records past the count are checked
+// untouched.
+TEST(NarrowPhase, CollideSpanningWritesNoMoreThanTheCountInDCollidesFlags) {
+  dInitODE2(0);
+  dSpaceID space = dSimpleSpaceCreate(nullptr);
+  MeshData mesh;
+  addFloor(mesh, 0.04, 0.001);
+  const dGeomID floor = mesh.build(space);
+  dWorldID world = dWorldCreate();
+  dBodyID body = dBodyCreate(world);
+  const dGeomID box = dCreateBox(space, 0.01, 0.01, 0.01);
+  dGeomSetBody(box, body);
+  dBodySetPosition(body, 0, 0, 0.0049);  // 0.1 mm into the floor
+  MeshCollisionScratch scratch;
+  constexpr double kUntouched = -12345;
+  for (const unsigned flags :
+       {4u, 4u | static_cast<unsigned>(CONTACTS_UNIMPORTANT), 0x10004u, 0u}) {
+    std::vector<dContactGeom> out(64);
+    for (dContactGeom& c : out) c.depth = kUntouched;
+    const int n = collideSpanning(box, floor, static_cast<int>(flags), out.data(),
+                                  sizeof(dContactGeom), scratch);
+    const int room = static_cast<int>(flags & 0xffffu);
+    EXPECT_EQ(n, room) << std::hex << flags;  // the box touches more than 4 triangles
+    for (int i = room; i < 64; ++i) ASSERT_EQ(out[i].depth, kUntouched) << std::hex << flags;
+  }
+  dSpaceDestroy(space);
+  dWorldDestroy(world);
+}
+
+// The edge tables are cached by mesh data (MeshCollisionScratch), whose address ODE may give to
+// another mesh once one is destroyed. A floor with a ridge across its middle, with the same
+// triangle count and the same first and last triangles as a flat one, must not be taken for it;
+// forget() drops a table.
+TEST(NarrowPhase, EdgeTablesTellAnotherMeshOfTheSameSizeAndAreForgotten) {
+  dInitODE2(0);
+  dSpaceID space = dSimpleSpaceCreate(nullptr);
+  MeshData flat, ridged;
+  addFloor(flat, 0.01, 0.001);
+  addFloor(ridged, 0.01, 0.001);
+  for (std::size_t v = 0; v < ridged.vertices.size(); v += 3) {
+    if (std::abs(ridged.vertices[v]) < 1e-9) ridged.vertices[v + 2] = 0.002;  // x = 0: 2 mm up
+  }
+  const dGeomID flat_geom = flat.build(space), ridged_geom = ridged.build(space);
+  const MeshEdges flat_edges(flat_geom), ridged_edges(ridged_geom);
+  ASSERT_EQ(flat_edges.triangles(), ridged_edges.triangles());
+  EXPECT_TRUE(flat_edges.describes(flat_geom));
+  EXPECT_FALSE(flat_edges.describes(ridged_geom));
+  int sharp_flat = 0, sharp_ridged = 0;
+  for (int t = 0; t < flat_edges.triangles(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      sharp_flat += flat_edges.smooth(t, k) ? 0 : 1;
+      sharp_ridged += ridged_edges.smooth(t, k) ? 0 : 1;
+    }
+  }
+  EXPECT_GT(sharp_ridged, sharp_flat);  // the ridge's edges turn by 63 degrees
+  MeshCollisionScratch scratch;
+  scratch.edgesOf(flat_geom);
+  ASSERT_EQ(scratch.edges.size(), 1u);
+  scratch.forget(dGeomTriMeshGetTriMeshDataID(flat_geom));
+  EXPECT_TRUE(scratch.edges.empty());
+  dSpaceDestroy(space);
+}
+
+// A world (gravity 9.81 m/s^2 along -z) whose hash space holds a floor of 1 mm triangles, `side` m
+// square, and a mesh nut blank (built by `add_nut`) lying flat on it at (x, 0.3 mm) on a new body.
+struct NutOnMeshFloor {
+  dWorldID world = dWorldCreate();
+  dSpaceID space = dHashSpaceCreate(nullptr);
+  MeshData floor_mesh, nut_mesh;
+  dGeomID floor = nullptr;
+  dBodyID body = nullptr;
+  NutOnMeshFloor(double side, void (*add_nut)(MeshData&), double x) {
+    dInitODE2(0);
+    dWorldSetGravity(world, 0, 0, -9.81);
+    addFloor(floor_mesh, side, 0.001);
+    floor = floor_mesh.build(space);
+    add_nut(nut_mesh);
+    body = addNutBody(world, nut_mesh.build(space), x, 0.0003);
+  }
+  ~NutOnMeshFloor() {  // geoms before the mesh data (members, destroyed after this)
+    dSpaceDestroy(space);
+    dWorldDestroy(world);
+  }
+};
+
 // A mesh part on a mesh floor at the rheonomic step: at h = 0.01 s gravity alone sinks a resting
 // part 1 mm per step before the contacts push it back, and ODE's trimesh-trimesh test then
 // finds the floor triangles' edges poking past the part's side faces, and gives those contacts
@@ -362,32 +474,20 @@ TEST(NarrowPhase, MeshEdgesTellTheFloorsSeamsFromItsBorderAndCorners) {
 // speed once it has caught up (from rest it reaches it in v / (mu g) = 34 ms); it is measured
 // over the last 1.5 s of 2 s. With ODE's normals it was carried at 65 % of the belt's speed.
 TEST(NarrowPhase, MeshNutOnATessellatedBeltIsCarriedAtTheBeltSpeed) {
-  dInitODE2(0);
-  dWorldID world = dWorldCreate();
-  dWorldSetGravity(world, 0, 0, -9.81);
-  dSpaceID space = dHashSpaceCreate(nullptr);
-  MeshData floor_mesh, nut_mesh;
-  addFloor(floor_mesh, 0.6, 0.001);
-  addHexPrism(nut_mesh);
-  const dGeomID belt = floor_mesh.build(space);
-  dBodyID body = addNutBody(world, nut_mesh.build(space), -0.2, 0.0003);
+  NutOnMeshFloor scene(0.6, addHexPrism, -0.2);
   const double speed = 0.1, mu = 0.3, h = 0.01;
-  {
-    FeederSet feeders;
-    feeders.add(belt, MotionLaw::belt({1, 0, 0}, speed));
-    ContactCollider::Settings settings;
-    settings.default_surface.mu = mu;
-    double x_start = 0;
-    runCollider(world, space, feeders, settings, 200, h, [&](int step) {
-      if (step == 50) x_start = dBodyGetPosition(body)[0];
-    });
-    // the nut's mean velocity over simulated steps 50-200 (m/s of simulated time)
-    const double carried_velocity = (dBodyGetPosition(body)[0] - x_start) / (150 * h);
-    EXPECT_NEAR(carried_velocity, speed, 0.03 * speed);
-    EXPECT_NEAR(dBodyGetPosition(body)[2], 0.0025, 0.001);  // still on the belt
-  }
-  dSpaceDestroy(space);
-  dWorldDestroy(world);
+  FeederSet feeders;
+  feeders.add(scene.floor, MotionLaw::belt({1, 0, 0}, speed));
+  ContactCollider::Settings settings;
+  settings.default_surface.mu = mu;
+  double x_start = 0;
+  runCollider(scene.world, scene.space, feeders, settings, 200, h, [&](int step) {
+    if (step == 50) x_start = dBodyGetPosition(scene.body)[0];
+  });
+  // the nut's mean velocity over simulated steps 50-200 (m/s of simulated time)
+  const double carried_velocity = (dBodyGetPosition(scene.body)[0] - x_start) / (150 * h);
+  EXPECT_NEAR(carried_velocity, speed, 0.03 * speed);
+  EXPECT_NEAR(dBodyGetPosition(scene.body)[2], 0.0025, 0.001);  // still on the belt
 }
 
 // A mesh nut blank lying on `floor` (top at z = 0) slides without friction (mu = 0) at
@@ -427,6 +527,44 @@ TEST(NarrowPhase, FrictionlessMeshNutKeepsItsVelocityOnAMeshFloorAndOnABox) {
     dSpaceDestroy(space);
     dWorldDestroy(world);
   }
+}
+
+// A nut lying flat on a flat floor of 1 mm triangles: its bottom face and the floor are coplanar.
+// Sliding without friction, nothing can tip it: the floor pushes straight up, on a footprint round
+// its centre of mass. But ODE's trimesh-trimesh test finds contacts only where triangles cross:
+// when rounding lifts one side of the face a nanometre, that side has none, gravity swings the
+// free side down by g h in the step, and the nut spun at 13-18 rad/s (8 of 100 steps), landing
+// up to 1 mm deep. Resting contacts (ContactCollider, Settings::speculative) keep the previous
+// step's points over the floor as contacts across their gap. Checked each step of 1 s at
+// h = 0.01 s: no spin above 0.5 rad/s (an edge of the nut then moves 2.5 mm/s); from 0.2 s on
+// the nut flat on the floor, its centre within 0.05 mm of its half thickness (the first step has
+// no history: the nut, placed touching, sinks g h^2 = 1 mm and ERP lifts it back by a fifth of
+// the rest each step); and its velocity kept to 1e-3 m/s.
+TEST(NarrowPhase, FrictionlessMeshNutSlidesFlatOverTheSeamsWithoutSpinning) {
+  NutOnMeshFloor scene(0.4, addHoledNut, -0.1);
+  const dBodyID body = scene.body;
+  dBodySetLinearVel(body, 0.1, 0.03, 0);
+  FeederSet feeders;
+  ContactCollider::Settings settings;
+  settings.default_surface.mu = 0;
+  settings.speculative = true;
+  double max_spin = 0, max_height_error = 0;
+  int spinning_steps = 0;
+  runCollider(scene.world, scene.space, feeders, settings, 101, 0.01, [&](int step) {
+    if (step == 0) return;  // the state after step - 1
+    const dReal* w = dBodyGetAngularVel(body);
+    const double spin = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);  // rad/s
+    max_spin = std::max(max_spin, spin);
+    spinning_steps += spin > 0.5 ? 1 : 0;
+    if (step > 20) {
+      max_height_error = std::max(max_height_error, std::abs(dBodyGetPosition(body)[2] - 0.0025));
+    }
+  });
+  EXPECT_LT(max_spin, 0.5) << spinning_steps << " of 100 steps above 0.5 rad/s";
+  EXPECT_LT(max_height_error, 5e-5);
+  const dReal* v = dBodyGetLinearVel(body);
+  EXPECT_NEAR(v[0], 0.1, 1e-3);
+  EXPECT_NEAR(v[1], 0.03, 1e-3);
 }
 
 }  // namespace

@@ -39,6 +39,19 @@
 /// it closes. The contacts go through the SurfaceCallback and the FeederSet like any other
 /// (the motionN is set after the callback) and are counted (speculativeContactCount).
 ///
+/// Resting contacts (also Settings::speculative): ODE's trimesh-trimesh test makes contacts
+/// only where triangles cross, so a mesh part lying flat on a fixture mesh, one side of its face
+/// lifted a nanometre by rounding, gets contacts on the other side only; gravity then swings the
+/// free side down by g h within the step (a flat mesh nut on 1 mm triangles spun at 13-18 rad/s at
+/// h = 0.01 s). So each point where a mesh part touched a fixture mesh (MeshCollisionScratch::
+/// fixture) is kept, in the part's body frame with the fixture triangle under it, for the next
+/// pass: there, the pair's points that are still over the fixture's smooth surface
+/// (surfacePointOver) within speculative_fraction times the part's smallest half extent of it
+/// join the new contacts (at the point's foot on the face, with the face's normal), the union is
+/// reduced to max_contacts_per_pair spanning it (collideSpanning's rule), and the kept ones that
+/// lie across a gap become speculative contacts (the gap as above). They are counted
+/// (restingContactCount).
+///
 /// ## Warm start
 /// ODE's quickstep starts every row from zero, so a heap's weight is rebuilt from nothing each
 /// step, one layer per Gauss-Seidel sweep, and stays short of it at a fixed iteration count.
@@ -168,6 +181,10 @@ class ContactCollider {
   void collide(dSpaceID space, double time, double step = 0.0);
   /// Empties the contact joint group (collide does it). Does not clear a pending error.
   void clearJoints();
+  /// Forgets what the collider learnt of a fixture mesh's edges (collideSpanning's edge table,
+  /// narrow_phase.hpp): call it before destroying `data` (dGeomTriMeshDataDestroy), or after
+  /// moving its vertices (dGeomTriMeshDataUpdate), while the collider lives on.
+  void forgetMesh(dTriMeshDataID data) { mesh_buffer_.forget(data); }
   /// A dNearCallback; `data` must be a ContactCollider*. Never throws: an exception inside is
   /// kept (the first one) and the rest of the pass is skipped; see rethrowPendingError.
   static void nearCallback(void* data, dGeomID o1, dGeomID o2);
@@ -193,6 +210,10 @@ class ContactCollider {
   int contactCount() const { return static_cast<int>(joints_.size()); }
   /// Of those, the speculative ones (Settings::speculative): contacts across a gap.
   int speculativeContactCount() const { return speculative_count_; }
+  /// Of those, the resting ones (Settings::speculative, file comment): points where a mesh part
+  /// touched a fixture mesh in the previous pass, kept for this one; counted among the
+  /// speculative contacts when they lie across a gap.
+  int restingContactCount() const { return resting_count_; }
   /// Of those, the ones that started from a previous contact's force (Settings::warm_start).
   int warmStartedContactCount() const { return warm_started_count_; }
   const std::vector<Joint>& joints() const { return joints_; }
@@ -219,6 +240,12 @@ class ContactCollider {
   // the new contacts of a pair their nearest previous force.
   void keepWarmStarts();
   void applyWarmStarts(dGeomID o1, dGeomID o2, dContact* contacts, int n);
+  // Resting contacts: for a mesh part against a fixture mesh, adds to contacts[0..n) the
+  // previous pass's points of the pair still over the fixture's smooth surface, reduces the
+  // union to max_contacts_per_pair spanning it, puts the ones across a gap last (their gaps
+  // (m) in resting_gap_) and returns the count; `gaps` receives how many lie across a gap.
+  // Remembers the pair's contacts for the next pass.
+  int addRestingContacts(dGeomID o1, dGeomID o2, dContact* contacts, int n, int& gaps);
 
   dWorldID world_;
   FeederSet& feeders_;
@@ -248,6 +275,20 @@ class ContactCollider {
   dGeomID ray_ = nullptr;
   int speculative_count_ = 0;
   double* contact_seconds_ = nullptr;  // setContactTimer
+  double step_ = 0;                    // s, the step of the current pass (collide)
+  // Resting contacts: each point where a mesh part touched a fixture mesh in a pass, in the part
+  // body's frame (m), with the fixture triangle under it; the previous pass's (grouped by pair:
+  // sorted by the geoms' addresses, each pair's points in their order) and the current one's;
+  // the working candidates and gaps; the count.
+  struct RestingPoint {
+    dGeomID part, fixture;
+    Vec3 local;
+    int triangle;
+  };
+  std::vector<RestingPoint> resting_, resting_next_;
+  std::vector<dContactGeom> resting_candidates_;
+  std::vector<double> resting_gap_;
+  int resting_count_ = 0;
   // Warm start: the previous pass's contacts, sorted by geom pair (lo < hi by address), each
   // with the force (N, world) it applied to lo's body; the force each new contact starts from,
   // on its joint's first body (set into its feedback once the joint exists).

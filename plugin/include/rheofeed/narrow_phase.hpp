@@ -64,6 +64,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <map>
 #include <tuple>
 #include <unordered_map>
@@ -87,6 +88,16 @@ inline constexpr double kSmoothEdgeAngle = 10.0;
 /// A contact normal within this angle (degrees) of its fixture triangle's face normal is that
 /// normal (rounding): any other, averaged ones included, is a candidate for the correction.
 inline constexpr double kFaceNormalTolerance = 0.1;
+
+/// Depths below this fraction of a contact set's span (s in the file comment; 1 um for a 10 mm
+/// nut) are rounding: the faces touch. keepSpanningContacts weighs them all alike, so that a part
+/// lying flat on coplanar triangles, whose depths ODE gives as noise around 1e-9 m (some zero or
+/// negative), keeps contacts round its whole footprint and not the few that rounding made
+/// deepest. With the former floor of 1e-6 of the deepest depth, a frictionless mesh nut sliding
+/// on 1 mm triangles at h = 0.01 s kept contacts on one side of its footprint in one step of
+/// seven and was kicked into spins of 5-15 rad/s
+/// (Plugin.NarrowPhase.FrictionlessMeshNutSlidesFlatOverTheSeamsWithoutSpinning).
+inline constexpr double kDepthResolution = 1e-4;
 
 namespace detail {
 inline const double kCosSmoothEdgeAngle = std::cos(kSmoothEdgeAngle * kPi / 180.0);
@@ -187,14 +198,16 @@ class MeshEdges {
     }
   }
 
-  /// Whether this table was built for `mesh`'s triangles (its count and the edge lengths of its
-  /// first and last triangle): the key is the mesh data's address, which ODE may reuse for
-  /// another mesh once one is destroyed.
+  /// Whether this table may describe `mesh`'s triangles: the same count, and the same edge
+  /// lengths (to 1e-9) of kFingerprintTriangles triangles spread evenly through the mesh. A
+  /// cache keyed by the mesh data's address (MeshCollisionScratch) checks this because ODE may
+  /// reuse the address for another mesh once one is destroyed; a sample cannot tell every
+  /// other mesh apart, so a caller that destroys mesh data calls MeshCollisionScratch::forget.
   bool describes(dGeomID mesh) const {
     const int n = dGeomTriMeshGetTriangleCount(mesh);
     if (n != triangles_) return false;
     const Fingerprint f = fingerprintOf(mesh, n);
-    for (int i = 0; i < 6; ++i) {
+    for (std::size_t i = 0; i < f.lengths.size(); ++i) {
       if (!(std::abs(f.lengths[i] - fingerprint_.lengths[i]) <=
             1e-9 * std::max(1.0, std::abs(f.lengths[i])))) {
         return false;
@@ -202,6 +215,9 @@ class MeshEdges {
     }
     return true;
   }
+
+  /// Triangles whose edge lengths describes() compares.
+  static constexpr int kFingerprintTriangles = 32;
 
   /// Whether the surface continues smoothly across edge `edge` (0: corner 0 to 1, 1: 1 to 2,
   /// 2: 2 to 0) of triangle `triangle`; false for an index out of range.
@@ -244,22 +260,24 @@ class MeshEdges {
 
  private:
   struct Fingerprint {
-    double lengths[6] = {0, 0, 0, 0, 0, 0};
+    std::array<double, 3 * kFingerprintTriangles> lengths{};  // m, 0 past the mesh's count
   };
   static Fingerprint fingerprintOf(dGeomID mesh, int n) {
     Fingerprint f;
-    if (n <= 0) return f;
-    const int which[2] = {0, n - 1};
-    for (int w = 0; w < 2; ++w) {
+    const int samples = std::min(n, kFingerprintTriangles);
+    for (int w = 0; w < samples; ++w) {
+      // triangles 0 .. n - 1 evenly, the first and the last among them
+      const int t =
+          samples > 1 ? static_cast<int>((static_cast<long long>(n - 1) * w) / (samples - 1)) : 0;
       dVector3 a, b, c;
-      dGeomTriMeshGetTriangle(mesh, which[w], &a, &b, &c);
+      dGeomTriMeshGetTriangle(mesh, t, &a, &b, &c);
       const dReal* p[3] = {a, b, c};
       for (int k = 0; k < 3; ++k) {
         const dReal* u = p[k];
-        const dReal* t = p[(k + 1) % 3];
-        f.lengths[3 * w + k] =
-            std::sqrt((u[0] - t[0]) * (u[0] - t[0]) + (u[1] - t[1]) * (u[1] - t[1]) +
-                      (u[2] - t[2]) * (u[2] - t[2]));
+        const dReal* v = p[(k + 1) % 3];
+        f.lengths[static_cast<std::size_t>(3 * w + k)] =
+            std::sqrt((u[0] - v[0]) * (u[0] - v[0]) + (u[1] - v[1]) * (u[1] - v[1]) +
+                      (u[2] - v[2]) * (u[2] - v[2]));
       }
     }
     return f;
@@ -272,8 +290,12 @@ class MeshEdges {
 };
 
 /// collideSpanning's working memory, kept by the caller between calls: the contact buffer, and
-/// the edge tables of the fixture meshes met (built on the first call that collides one, rebuilt
-/// when a mesh data's address is reused for another; never dropped).
+/// the edge tables of the fixture meshes met, keyed by their mesh data (built on the first call
+/// that collides one; kept until forget() or clear()). A table is rebuilt when its mesh data's
+/// address comes back with other triangles (MeshEdges::describes, a sample); an application
+/// that destroys mesh data (dGeomTriMeshDataDestroy) or moves its vertices
+/// (dGeomTriMeshDataUpdate) calls forget() for it, so that a new mesh at the same address, or
+/// the moved one, gets its own table.
 struct MeshCollisionScratch {
   std::vector<dContactGeom> contacts;
   std::unordered_map<dTriMeshDataID, MeshEdges> edges;
@@ -287,6 +309,11 @@ struct MeshCollisionScratch {
     return b == nullptr || dBodyIsKinematic(b);
   }
 
+  /// Drops the edge table of `data` (nothing when there is none).
+  void forget(dTriMeshDataID data) { edges.erase(data); }
+  /// Drops every edge table.
+  void clear() { edges.clear(); }
+
   const MeshEdges& edgesOf(dGeomID mesh) {
     const dTriMeshDataID data = dGeomTriMeshGetTriMeshDataID(mesh);
     auto it = edges.find(data);
@@ -295,6 +322,60 @@ struct MeshCollisionScratch {
     return it->second;
   }
 };
+
+/// A point's place over a fixture mesh's smooth surface (surfacePointOver).
+struct SurfacePoint {
+  int triangle = -1;             ///< the triangle under the point
+  double normal[3] = {0, 0, 0};  ///< its unit face normal (world, out of the fixture)
+  double corner[3] = {0, 0, 0};  ///< its corner 0 (m, world)
+  double height = 0;             ///< the point's height above its plane (m; < 0 below it)
+};
+
+/// Where point `p` (m, world) lies over the smooth surface of triangle mesh `mesh` (edge table
+/// `edges`) near triangle `start`: the triangle whose prism (the triangle swept along its normal)
+/// holds p, `start` or one reached from it across smooth edges (at most 4 triangles, each step
+/// across the edge p lies farthest beyond). False when the walk would cross a sharp edge or the
+/// mesh's border, takes more steps, or meets a degenerate triangle.
+inline bool surfacePointOver(dGeomID mesh, const MeshEdges& edges, int start, const double p[3],
+                             SurfacePoint& out) {
+  int t = start;
+  for (int walk = 0; walk < 4; ++walk) {
+    if (t < 0 || t >= edges.triangles()) return false;
+    dVector3 a, b, c;
+    dGeomTriMeshGetTriangle(mesh, t, &a, &b, &c);
+    const double v[9] = {a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]};
+    const MeshEdges::Normal f = MeshEdges::faceNormal(v);
+    if (!f.valid) return false;
+    const double height = (p[0] - v[0]) * f.x + (p[1] - v[1]) * f.y + (p[2] - v[2]) * f.z;
+    int beyond = -1;
+    double farthest = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double* p0 = v + 3 * k;
+      const double* p1 = v + 3 * ((k + 1) % 3);
+      const double e[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+      const double len = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+      if (!(len > 0)) return false;
+      // f x e / |e|: the edge's in-plane normal, into the triangle (counter-clockwise corners)
+      const double m[3] = {f.y * e[2] - f.z * e[1], f.z * e[0] - f.x * e[2],
+                           f.x * e[1] - f.y * e[0]};
+      const double inside =
+          ((p[0] - p0[0]) * m[0] + (p[1] - p0[1]) * m[1] + (p[2] - p0[2]) * m[2]) / len;
+      if (inside < farthest) {
+        farthest = inside;
+        beyond = k;
+      }
+    }
+    if (beyond < 0) {
+      out.triangle = t;
+      out.normal[0] = f.x, out.normal[1] = f.y, out.normal[2] = f.z;
+      out.corner[0] = v[0], out.corner[1] = v[1], out.corner[2] = v[2];
+      out.height = height;
+      return true;
+    }
+    t = edges.neighbour(t, beyond);  // -1 across a sharp edge or the border: false above
+  }
+  return false;
+}
 
 namespace detail {
 
@@ -321,8 +402,8 @@ inline int keepSpanningContacts(std::vector<dContactGeom>& all, int max, dContac
   // between calls so that a pair's collision allocates nothing once it has grown.
   thread_local std::vector<double> gap;
   gap.assign(n, 0.0);
-  // contacts touching or apart (depth <= 0) still count, as if 1e-6 of the deepest in
-  const double depth_floor = std::max(1e-6 * all[0].depth, 1e-12);
+  // contacts touching, apart (depth <= 0) or in by rounding (kDepthResolution) count alike
+  const double depth_floor = std::max({1e-6 * all[0].depth, kDepthResolution * s, 1e-12});
   for (std::size_t i = 1; i < n; ++i) gap[i] = contactSpan(all[i], all[0], s);
   std::size_t kept = 1;
   while (kept < static_cast<std::size_t>(max) && kept < n) {
@@ -390,6 +471,27 @@ inline bool namesTheTriangle(dGeomID partner) {
   return c == dTriMeshClass || c == dBoxClass || c == dCapsuleClass || c == dCylinderClass;
 }
 
+/// How far (m) the deepest corner of the mesh partner's triangle of contact c lies below the
+/// plane through `corner` with unit normal `face` (out of the fixture): the most any point of
+/// that triangle can penetrate along the face normal, and so a bound on the contact's depth along
+/// it. Infinite when c names no triangle of a mesh partner.
+inline double partnerTriangleDepthBound(const dContactGeom& c, dGeomID partner, bool partner_is_g1,
+                                        const double* corner, const double* face) {
+  const int triangle = partner_is_g1 ? c.side1 : c.side2;
+  if (dGeomGetClass(partner) != dTriMeshClass || triangle < 0 ||
+      triangle >= dGeomTriMeshGetTriangleCount(partner)) {
+    return std::numeric_limits<double>::infinity();
+  }
+  dVector3 v[3];
+  dGeomTriMeshGetTriangle(partner, triangle, &v[0], &v[1], &v[2]);
+  double deepest = -std::numeric_limits<double>::infinity();
+  for (const dVector3& p : v) {
+    deepest = std::max(deepest, -((p[0] - corner[0]) * face[0] + (p[1] - corner[1]) * face[1] +
+                                  (p[2] - corner[2]) * face[2]));
+  }
+  return std::max(0.0, deepest);
+}
+
 /// The internal-edge correction of the file comment for contact c, whose fixture mesh is
 /// `fixture` (c.g1 or c.g2) with edge table `edges`: returns whether it changed the contact.
 inline bool correctInternalEdgeNormal(dContactGeom& c, dGeomID fixture, const MeshEdges& edges) {
@@ -417,7 +519,16 @@ inline bool correctInternalEdgeNormal(dContactGeom& c, dGeomID fixture, const Me
     // ODE's normal turned out of the fixture, against this face's
     cos_f = sign * (c.normal[0] * f.x + c.normal[1] * f.y + c.normal[2] * f.z);
     if (walk == 0 && cos_f >= detail::kCosFaceNormalTolerance) {
-      return false;  // the face's own normal (to rounding): nothing to correct
+      // The face's own normal (to rounding): only the depth may need bounding. ODE's
+      // trimesh-trimesh test gives a part's face lying in the fixture's plane, where a face of
+      // the part stands on it (the nut's side or hole), the face normal with the depth of the
+      // fixture triangle's far corner behind that standing face: up to a fixture triangle's
+      // size (0.96 mm on 1 mm triangles), which kicked a flat nut up and spinning.
+      const double face[3] = {f.x, f.y, f.z};
+      const double bound = partnerTriangleDepthBound(c, partner, fixture_is_g2, v, face);
+      if (!(c.depth > bound)) return false;
+      c.depth = bound;
+      return true;
     }
     // a normal pointing into the face is a contact from the other side of a thin wall, not a seam
     if (cos_f < -0.5) return false;
@@ -458,11 +569,14 @@ inline bool correctInternalEdgeNormal(dContactGeom& c, dGeomID fixture, const Me
     break;
   }
   // depth: how far the contact point lies below the triangle's plane, and at least ODE's depth
-  // projected on the new normal. Not a mesh partner's deepest corner: its triangle reaches past
-  // this one, and on a curved fixture (the bowl's 4 degree cone) that corner lies below this
+  // projected on the new normal; at most how far a mesh partner's triangle reaches below that
+  // plane (a bound only). Not that reach itself: the partner's triangle reaches past this one,
+  // and on a curved fixture (the bowl's 4 degree cone) its deepest corner lies below this
   // triangle's plane where the fixture does not; that depth pushed a flat nut up every step and
   // made it hop (demos/results/bowl_feeder.md, section 9).
-  const double depth = std::max(-dist, std::abs(c.depth) * std::max(0.0, cos_f));
+  const double face[3] = {f.x, f.y, f.z};
+  const double depth = std::min(std::max(-dist, std::abs(c.depth) * std::max(0.0, cos_f)),
+                                partnerTriangleDepthBound(c, partner, fixture_is_g2, v, face));
   c.normal[0] = sign * f.x;
   c.normal[1] = sign * f.y;
   c.normal[2] = sign * f.z;
@@ -515,12 +629,17 @@ class TrimeshCullingMessageFilter {
 
 /// dCollide(o1, o2, max, out, stride) where neither geom is a triangle mesh; for a pair with
 /// one, every contact ODE finds, reduced to at most `max` that span the set (file comment).
-/// `max` >= 1 and `out` room for `max` records of `stride` bytes, as dCollide. `scratch` is
-/// the caller's memory, reused between calls. Returns the number of contacts written. While it
+/// `max` is dCollide's flags: its low 16 bits the number of records `out` has room for (each
+/// `stride` bytes), its high bits options (CONTACTS_UNIMPORTANT: any contacts will do, which the
+/// spanning set is). A count of 0 collides nothing and returns 0 (dCollide stops the program
+/// with ODE's debug message). `scratch` is the caller's memory, reused between calls. Returns
+/// the number of contacts written, at most the count. While it
 /// collides a mesh pair, ODE's message handler is replaced by one that drops the trimesh-trimesh
 /// culling warning (detail::dropTrimeshCullingMessage) and forwards every other message.
 inline int collideSpanning(dGeomID o1, dGeomID o2, int max, dContactGeom* out, int stride,
                            MeshCollisionScratch& scratch) {
+  const int room = max & 0xffff;  // ODE's NUMC_MASK
+  if (room < 1) return 0;
   if (dGeomGetClass(o1) != dTriMeshClass && dGeomGetClass(o2) != dTriMeshClass) {
     return dCollide(o1, o2, max, out, stride);
   }
@@ -533,7 +652,7 @@ inline int collideSpanning(dGeomID o1, dGeomID o2, int max, dContactGeom* out, i
     return dGeomGetClass(g) == dCylinderClass || dGeomGetClass(g) == dCapsuleClass;
   };
   const bool merges = stops_then_merges(o1) || stops_then_merges(o2);
-  int capacity = std::max(kMeshContactCapacity, max);
+  int capacity = std::max(kMeshContactCapacity, room);
   int n = 0, previous = -1;
   const detail::TrimeshCullingMessageFilter filter;
   // The fixture meshes of the pair, whose normals are corrected (file comment); their edge tables
@@ -575,7 +694,7 @@ inline int collideSpanning(dGeomID o1, dGeomID o2, int max, dContactGeom* out, i
       }
     }
   }
-  return detail::keepSpanningContacts(scratch.contacts, max, out, stride);
+  return detail::keepSpanningContacts(scratch.contacts, room, out, stride);
 }
 
 }  // namespace rheofeed

@@ -19,24 +19,29 @@ std::string seriesCsv(const RunMetrics& run) {
        "lost_too_fast,lost_left_feeder\n";
   char line[256];
   for (const DriftSample& d : run.series) {
-    std::snprintf(line, sizeof line, "%.6f,%d,%.8g,%.8g,%.8g,%d,%d,%d,%d,%d,%d,%d\n", d.time,
-                  d.parts, d.mean_velocity, d.ci95, d.mean_height, d.exited, d.fell,
-                  d.through_fixture, d.out_of_bounds, d.nonfinite, d.too_fast, d.left_feeder);
+    // the spread of one part (or none) has no confidence interval: the field stays empty
+    char ci[32] = "";
+    if (d.parts >= 2) std::snprintf(ci, sizeof ci, "%.8g", d.ci95);
+    std::snprintf(line, sizeof line, "%.6f,%d,%.8g,%s,%.8g,%d,%d,%d,%d,%d,%d,%d\n", d.time, d.parts,
+                  d.mean_velocity, ci, d.mean_height, d.exited, d.fell, d.through_fixture,
+                  d.out_of_bounds, d.nonfinite, d.too_fast, d.left_feeder);
     s << line;
   }
   return s.str();
 }
 
 std::string summaryJson(const RunMetrics& r) {
+  char ci[32] = "null";  // no confidence interval over fewer than two parts
+  if (r.parts >= 2) std::snprintf(ci, sizeof ci, "%.8g", r.mean_drift_ci95);
   char b[768];
   std::snprintf(b, sizeof b,
                 ", \"method\": \"%s\", \"time_step_s\": %.8g, \"parts\": %d, "
-                "\"drift_unit\": \"%s\", \"mean_drift\": %.8g, \"mean_drift_ci95\": %.8g, "
+                "\"drift_unit\": \"%s\", \"mean_drift\": %.8g, \"mean_drift_ci95\": %s, "
                 "\"vertical_displacement_m\": %.8g, \"throughput_parts_per_s\": %.8g, "
                 "\"cpu_seconds\": %.6g, \"simulated_seconds\": %.6g, \"real_time_factor\": %.6g",
                 toString(r.method), r.time_step, r.parts, r.angular ? "rad/s" : "m/s", r.mean_drift,
-                r.mean_drift_ci95, r.vertical_displacement, r.throughput, r.cpu_seconds,
-                r.simulated_seconds, r.real_time_factor);
+                ci, r.vertical_displacement, r.throughput, r.cpu_seconds, r.simulated_seconds,
+                r.real_time_factor);
   std::string run = b;  // the run's own settings: seed and drift models
   run += ", \"seed\": " + std::to_string(r.seed) + ", \"drift_models\": [";
   for (std::size_t k = 0; k < r.drift_models.size(); ++k) {

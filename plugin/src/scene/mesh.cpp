@@ -112,9 +112,10 @@ TriangleMesh loadTriangleMesh(const fs::path& file, double scale) {
       const double xyz[3] = {scale * p.x, scale * p.y, scale * p.z};
       for (int k = 0; k < 3; ++k) {
         if (!std::isfinite(xyz[k])) {
-          throw std::invalid_argument(name + ": vertex " + std::to_string(offset + v) +
-                                      " has a non-finite coordinate (" + std::string(1, "xyz"[k]) +
-                                      " = " + formatNumber(xyz[k]) + " m)");
+          throw std::invalid_argument(
+              name + ": vertex " + std::to_string(offset + v) + " has a non-finite coordinate (" +
+              std::string(1, "xyz"[k]) + " = " + formatNumber(xyz[k]) +
+              ", the file's value times scale " + formatNumber(scale) + ")");
         }
       }
       mesh.vertices.insert(mesh.vertices.end(), xyz, xyz + 3);
@@ -174,8 +175,8 @@ MassProperties massProperties(const TriangleMesh& mesh, double density) {
   const double volume = six_volume / 6;
   if (!(volume > 0)) {
     throw std::invalid_argument(name + ": signed volume " + formatNumber(volume) +
-                                " m^3 <= 0: the mesh is open or inside out (triangles must be "
-                                "counter-clockwise seen from outside)");
+                                " (the mesh's length unit cubed) <= 0: the mesh is open or inside "
+                                "out (triangles must be counter-clockwise seen from outside)");
   }
   // A flat or sliver solid: its volume against the sphere about r0 through the farthest vertex.
   double r2 = 0;
@@ -186,7 +187,8 @@ MassProperties massProperties(const TriangleMesh& mesh, double density) {
   const double sphere = 4.0 / 3.0 * kPi * r2 * std::sqrt(r2);
   if (!(volume >= limits::kMinVolumeFraction * sphere)) {
     throw std::invalid_argument(name + ": degenerate solid: volume " + formatNumber(volume) +
-                                " m^3 is " + formatNumber(volume / sphere) +
+                                " (the mesh's length unit cubed) is " +
+                                formatNumber(volume / sphere) +
                                 " of its bounding sphere's; at least " +
                                 formatNumber(limits::kMinVolumeFraction) + " is needed for a part");
   }

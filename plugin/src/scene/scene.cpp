@@ -609,9 +609,9 @@ std::vector<PartInstance> drawParts(const Scene& scene) {
       const double extent = spec.size[0].mean * unit_radius;
       if (!(extent >= limits::kMinSize && extent <= limits::kMaxSize)) {
         bad("parts[" + std::to_string(s) + "].size[0].mean", spec.size[0].mean,
-            "scales the mesh's bounding radius " + show(unit_radius) + " m to " + show(extent) +
-                " m, which must be in [" + show(limits::kMinSize) + ", " + show(limits::kMaxSize) +
-                "] m (mass and inertia must stay representable)");
+            "scales the mesh's bounding radius " + show(unit_radius) + " (the file's units) to " +
+                show(extent) + " m, which must be in [" + show(limits::kMinSize) + ", " +
+                show(limits::kMaxSize) + "] m (mass and inertia must stay representable)");
       }
     }
     for (int i = 0; i < spec.count; ++i) {
