@@ -59,6 +59,7 @@ RunMetrics run() {
   r.parts = 12;
   r.cpu_seconds = 2.5;
   r.simulated_seconds = 10;
+  r.warmup = 1.5;
   r.real_time_factor = 0.25;
   RunHealth& h = r.health;
   h.steps = 1000;
@@ -133,6 +134,19 @@ TEST(SeriesCsv, AnAngularDriftNamesItsUnitRadiansPerSecond) {
   EXPECT_EQ(rows[0][3], "ci95_radps");
 }
 
+// One part has no spread, so no confidence interval: null in the JSON and an empty CSV field,
+// not a 0 that claims certainty.
+TEST(SummaryJson, OnePartHasNoConfidenceInterval) {
+  RunMetrics r = run();
+  r.parts = 1;
+  for (DriftSample& d : r.series) d.parts = 1;
+  EXPECT_TRUE(json::parse(summaryJson(r))["mean_drift_ci95"].is_null());
+  const std::string csv = seriesCsv(r);
+  const std::string row =
+      csv.substr(csv.find('\n') + 1, csv.find('\n', csv.find('\n') + 1) - csv.find('\n') - 1);
+  EXPECT_NE(row.find(",1,0.012345679,,"), std::string::npos) << row;  // parts, drift, no ci95
+}
+
 TEST(SummaryJson, ParsesToTheRunMetricsWritten) {
   const RunMetrics r = run();
   const std::string text = summaryJson(r);
@@ -150,6 +164,7 @@ TEST(SummaryJson, ParsesToTheRunMetricsWritten) {
               kEightDigits * 4e-4);
   EXPECT_DOUBLE_EQ(j["throughput_parts_per_s"].get<double>(), 1.5);
   EXPECT_DOUBLE_EQ(j["simulated_seconds"].get<double>(), 10);
+  EXPECT_DOUBLE_EQ(j["warmup_s"].get<double>(), 1.5);
   EXPECT_EQ(j["seed"].get<std::uint64_t>(), r.seed);
   EXPECT_EQ(j["drift_models"], json(r.drift_models));
 

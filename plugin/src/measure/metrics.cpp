@@ -174,6 +174,7 @@ class RunMeter : public RunObserver {
   }
   void onEnd(const Simulation& sim) override {
     m_.simulated_seconds = sim.time();
+    m_.warmup = out_.warmup;
     m_.parts = sim.numParts();
     m_.health = sim.health();
     finishDrift(sim);

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/output/output.hpp"
 #include "rheofeed/output/plot.hpp"
 
@@ -43,6 +44,7 @@ std::string summaryJson(const RunMetrics& r) {
                 ci, r.vertical_displacement, r.throughput, r.cpu_seconds, r.simulated_seconds,
                 r.real_time_factor);
   std::string run = b;  // the run's own settings: seed and drift models
+  run += ", \"warmup_s\": " + formatNumber(r.warmup);  // the mean drift's window starts there
   run += ", \"seed\": " + std::to_string(r.seed) + ", \"drift_models\": [";
   for (std::size_t k = 0; k < r.drift_models.size(); ++k) {
     run += (k ? ", " : "") + jsonQuoted(r.drift_models[k]);

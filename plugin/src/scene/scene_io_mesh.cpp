@@ -18,9 +18,11 @@ namespace fs = std::filesystem;
 using io::fail;
 using io::show;
 
-// A fixture mesh, scaled: its bounding box diagonal within the size limits and, placed at
-// `position`, every vertex within the coordinate limits (scene.hpp).
-void checkFixtureMesh(const TriangleMesh& mesh, const Vec3& position, const std::string& path) {
+// A fixture mesh, scaled by `scale` (the geom's "scale", named in the messages): its bounding
+// box diagonal within the size limits and, placed at `position`, every vertex within the
+// coordinate limits (scene.hpp).
+void checkFixtureMesh(const TriangleMesh& mesh, double scale, const Vec3& position,
+                      const std::string& path) {
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   for (std::size_t v = 0; v + 2 < mesh.vertices.size(); v += 3) {
     for (int k = 0; k < 3; ++k) {
@@ -29,7 +31,7 @@ void checkFixtureMesh(const TriangleMesh& mesh, const Vec3& position, const std:
     }
   }
   const double diagonal = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-  const std::string name = "mesh '" + mesh.source + "'";
+  const std::string name = "mesh '" + mesh.source + "' at scale " + show(scale);
   auto range = [](double low, double high) {  // as Scene::validate writes its ranges
     std::ostringstream out;
     out << "[" << low << ", " << high << "] m";
@@ -80,7 +82,7 @@ void loadSceneMeshes(Scene& scene, const fs::path& base_dir, const MeshLoader& m
       const std::string path =
           "fixtures[" + std::to_string(i) + "].geoms[" + std::to_string(g) + "].mesh";
       s.mesh_data = get(s.mesh, s.mesh_scale, path);
-      checkFixtureMesh(*s.mesh_data, scene.fixtures[i].geoms[g].pose.position, path);
+      checkFixtureMesh(*s.mesh_data, s.mesh_scale, scene.fixtures[i].geoms[g].pose.position, path);
     }
   }
   for (std::size_t i = 0; i < scene.parts.size(); ++i) {

@@ -129,10 +129,15 @@ struct RunMetrics {
   std::vector<std::string> drift_models;
   bool angular = false;  ///< the drift is an angular velocity (rad/s) instead of m/s
   std::vector<DriftSample> series;
+  /// Start (s) of the window of mean_drift and throughput (the scene's outputs.warmup); the
+  /// series covers the whole run.
+  double warmup = 0;
   /// Mean drift (m/s along d, or rad/s about the axis) over [warmup, end]: total displacement of
   /// the measured parts divided by time, averaged over parts.
   double mean_drift = 0;
-  double mean_drift_ci95 = 0;        ///< 95 % CI half-width over parts (m/s)
+  /// 95 % CI half-width over parts (the drift's unit); 0 with fewer than two parts, where it is
+  /// not defined (the outputs write null, an empty field or n/a).
+  double mean_drift_ci95 = 0;
   double vertical_displacement = 0;  ///< mean z change of the parts since they spawned (m)
   double throughput = 0;             ///< parts per second through the exit plane (after warmup)
   int parts = 0;                     ///< spawned parts
