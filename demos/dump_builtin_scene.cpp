@@ -86,7 +86,8 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
         "bowl_feeder_primitives`; written by dump_builtin_scene from builtin_scenes.hpp "
         "bowlFeederScene()): the same bowl, tooling and outlet as bowl_feeder_fill. Rheonomic at "
         "h = 0.01 s (the paper's step) on the local vibration law, with no nut lost or sunk in 60 "
-        "s, where the mesh bowl of bowl_feeder.json loses 5 of 12 in 12 s at that step. " +
+        "s (the mesh bowl of bowl_feeder.json lost 5 of 12 in 12 s at that step until its mesh "
+        "contacts were fixed; demos/results/bowl_feeder.md, sections 1 and 8). " +
             kDriftTableNote);
   }
   insertComment(
@@ -122,7 +123,7 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
       "friction cone) at 2000 steps per cycle it is within 3 % on the floor and 9 % on the ramp "
       "(demos/results/bowl_local_law.md, last section). calibrated_drift: 0.313 rad/s about +z, "
       "the mesh bowl's former calibration on its ramp (measured while ODE kept 8 contacts per "
-      "mesh pair, since void there: bowl_feeder.json is now 0.212), kept here for "
+      "mesh pair, since void there; bowl_feeder.json now runs on the local law), kept here for "
       "`--drift-model calibrated_drift` and as the rotation the tooling tests' kinematics use; it "
       "is not this bowl's (its runs are 13 % fast on the floor and 2-3x on the ramp).");
   insertComment(json, "\"name\": \"m6_nuts\",",

@@ -90,7 +90,9 @@ int calibrateCommand(const CalibrateArgs& args) {
     if (report.calibrated == 0) {
       std::fprintf(stderr,
                    "rheofeed calibrate: the scene gives the calibration of every vibrating "
-                   "fixture that takes one; writing it unchanged (--force calibrates again)\n");
+                   "fixture that takes one: nothing calibrated (--force calibrates again); "
+                   "writing the scene with that calibration and the drift model used here "
+                   "(--drift-model, if given), without its comments\n");
     }
     noteIgnoredCycleOptions("rheofeed calibrate", args.cycles_given, report.calibrated > 0,
                             options.classical);
@@ -106,6 +108,7 @@ int calibrateCommand(const CalibrateArgs& args) {
         (report.calibrated > 0
              ? "Calibrated: " + report.summary.substr(0, report.summary.size() - 1)
              : std::string("No fixture calibrated: the scene gave them.")) +
+        " Each fixture's drift_model is the one this calibration used." +
         " Re-run the calibration whenever the vibration, the parts or mu change.";
     const std::size_t brace = text.find('{');
     text.insert(brace + 1, "\n  \"comment\": \"" + jsonString(comment) + "\",");

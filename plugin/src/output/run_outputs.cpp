@@ -125,8 +125,12 @@ std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::strin
      << "'\n"
      << "set title '" << run.scene << ": " << toString(run.method) << ", h = " << run.time_step
      << " s, " << run.parts << " parts'\n"
-     << "plot $data using 1:($3-$4):($3+$4) with filledcurves fc rgb '#c0d0f0' title '95 % CI', "
-        "$data using 1:3 with lines lw 2 lc rgb '#1040a0' title 'mean over parts'\n";
+     << "plot ";
+  // the band only where there is one (two parts or more; the CSV's field is empty otherwise)
+  if (run.parts >= 2) {
+    gp << "$data using 1:($3-$4):($3+$4) with filledcurves fc rgb '#c0d0f0' title '95 % CI', ";
+  }
+  gp << "$data using 1:3 with lines lw 2 lc rgb '#1040a0' title 'mean over parts'\n";
   const std::string png = base.string() + ".png";
   if (plotPng(gp.str(), {{"data", csv}}, png)) written.push_back(png);
   const std::string title = run.scene + ": " + toString(run.method);
