@@ -391,7 +391,11 @@ void ContactCollider::keepWarmStarts() {
     warm_.push_back({g1_lo ? j.g1 : j.g2, g1_lo ? j.g2 : j.g1, j.position,
                      g1_lo ? j.normal : -j.normal, g1_lo ? on_g1 : -on_g1, j.persisted, false});
   }
-  std::sort(warm_.begin(), warm_.end(), [](const WarmContact& x, const WarmContact& y) {
+  // Stable: a pair's contacts keep the joints' order. An unstable sort left them in an order that
+  // depended on how other pairs' addresses compared, and a new contact exactly as near to two of
+  // them took the later one: mesh scenes ran differently from another folder
+  // (BowlFeeder.MeshBowlRunsTheSameFromAnyFolder).
+  std::stable_sort(warm_.begin(), warm_.end(), [](const WarmContact& x, const WarmContact& y) {
     return std::less<dGeomID>()(x.lo, y.lo) || (x.lo == y.lo && std::less<dGeomID>()(x.hi, y.hi));
   });
 }
