@@ -210,9 +210,10 @@ class ContactCollider {
   int contactCount() const { return static_cast<int>(joints_.size()); }
   /// Of those, the speculative ones (Settings::speculative): contacts across a gap.
   int speculativeContactCount() const { return speculative_count_; }
-  /// Of those, the resting ones (Settings::speculative, file comment): points where a mesh part
-  /// touched a fixture mesh in the previous pass, kept for this one; counted among the
-  /// speculative contacts when they lie across a gap.
+  /// Resting contacts kept in this pass (Settings::speculative, file comment): points where a mesh
+  /// part touched a fixture mesh in the previous pass, kept for this one, counted when kept (before
+  /// the SurfaceCallback or the FeederSet, which may still drop them); the joints among them that
+  /// lie across a gap are also counted as speculative contacts.
   int restingContactCount() const { return resting_count_; }
   /// Of those, the ones that started from a previous contact's force (Settings::warm_start).
   int warmStartedContactCount() const { return warm_started_count_; }
