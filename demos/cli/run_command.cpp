@@ -15,6 +15,7 @@
 
 #include "cli/commands.hpp"
 #include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/measure/statistics.hpp"
 #include "rheofeed/number_format.hpp"
 #include "rheofeed/output/animation.hpp"
 #include "rheofeed/output/output.hpp"
@@ -296,7 +297,7 @@ int runCommand(const RunArgs& args) {
       blocks.emplace_back(toString(m), seriesCsv(r));
       const RunHealth& h = r.health;
       char ci[32] = "n/a";  // no confidence interval over fewer than two parts
-      if (r.parts >= 2) std::snprintf(ci, sizeof ci, "%.5f", r.mean_drift_ci95);
+      if (ci95Defined(r.parts)) std::snprintf(ci, sizeof ci, "%.5f", r.mean_drift_ci95);
       std::printf("| %s | %.3g | %d | %.5f | %s | %.4f | %.2f | %.2f | %.4f | %d | %.1f %% |\n",
                   toString(m), r.time_step, r.parts, r.mean_drift, ci, r.vertical_displacement,
                   r.throughput, r.cpu_seconds, r.real_time_factor, h.partsLost(),

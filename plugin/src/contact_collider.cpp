@@ -86,6 +86,14 @@ void ContactCollider::rethrowPendingError() {
   std::rethrow_exception(error);
 }
 
+namespace {
+// Orders geom pairs (a, b) by address: groups a pair's entries in a sorted list (the warm start's
+// and the resting points'); within a pair, stable sorts keep the order of insertion.
+bool pairBefore(dGeomID a1, dGeomID b1, dGeomID a2, dGeomID b2) {
+  return std::less<dGeomID>()(a1, a2) || (a1 == a2 && std::less<dGeomID>()(b1, b2));
+}
+}  // namespace
+
 void ContactCollider::collide(dSpaceID space, double time, double step) {
   rethrowPendingError();           // an error of a manual pass is not lost
   feeders_.beginStep(time, step);  // first: a refused time or step leaves everything as it was
@@ -96,8 +104,7 @@ void ContactCollider::collide(dSpaceID space, double time, double step) {
   resting_next_.clear();
   std::stable_sort(resting_.begin(), resting_.end(),
                    [](const RestingPoint& x, const RestingPoint& y) {
-                     return std::less<dGeomID>()(x.part, y.part) ||
-                            (x.part == y.part && std::less<dGeomID>()(x.fixture, y.fixture));
+                     return pairBefore(x.part, x.fixture, y.part, y.fixture);
                    });
   const bool speculative = settings_.speculative && step > 0;
   if (speculative) {
@@ -214,7 +221,10 @@ int ContactCollider::addRestingContacts(dGeomID o1, dGeomID o2, dContact* contac
   if (!part) return n;
   const bool fixture_is_g2 = fixture == o2;
   const double out_sign = fixture_is_g2 ? 1.0 : -1.0;  // ODE's normal: out of g2 into g1
-  const MeshEdges& edges = mesh_buffer_.edgesOf(fixture);
+  // collideSpanning has just looked this table up (and checked it) for the pair
+  const auto known = mesh_buffer_.edges.find(dGeomTriMeshGetTriMeshDataID(fixture));
+  const MeshEdges& edges =
+      known != mesh_buffer_.edges.end() ? known->second : mesh_buffer_.edgesOf(fixture);
   const dBodyID body = dGeomGetBody(part);
   const dReal* x = dBodyGetPosition(body);
   const dReal* r = dBodyGetRotation(body);  // row-major 3x4
@@ -223,12 +233,11 @@ int ContactCollider::addRestingContacts(dGeomID o1, dGeomID o2, dContact* contac
   resting_candidates_.assign(n, dContactGeom{});
   for (int i = 0; i < n; ++i) resting_candidates_[static_cast<std::size_t>(i)] = contacts[i].geom;
   const double margin = settings_.speculative_fraction * smallestHalfExtent(part);
-  const auto first = std::lower_bound(
-      resting_.begin(), resting_.end(), std::make_pair(part, fixture),
-      [](const RestingPoint& p, const std::pair<dGeomID, dGeomID>& key) {
-        return std::less<dGeomID>()(p.part, key.first) ||
-               (p.part == key.first && std::less<dGeomID>()(p.fixture, key.second));
-      });
+  const auto first =
+      std::lower_bound(resting_.begin(), resting_.end(), std::make_pair(part, fixture),
+                       [](const RestingPoint& p, const std::pair<dGeomID, dGeomID>& key) {
+                         return pairBefore(p.part, p.fixture, key.first, key.second);
+                       });
   for (auto it = first; it != resting_.end() && it->part == part && it->fixture == fixture; ++it) {
     const Vec3& l = it->local;
     const double p[3] = {x[0] + r[0] * l.x + r[1] * l.y + r[2] * l.z,
@@ -396,7 +405,7 @@ void ContactCollider::keepWarmStarts() {
   // them took the later one: mesh scenes ran differently from another folder
   // (BowlFeeder.MeshBowlRunsTheSameFromAnyFolder).
   std::stable_sort(warm_.begin(), warm_.end(), [](const WarmContact& x, const WarmContact& y) {
-    return std::less<dGeomID>()(x.lo, y.lo) || (x.lo == y.lo && std::less<dGeomID>()(x.hi, y.hi));
+    return pairBefore(x.lo, x.hi, y.lo, y.hi);
   });
 }
 
@@ -407,8 +416,7 @@ void ContactCollider::applyWarmStarts(dGeomID o1, dGeomID o2, dContact* contacts
   const auto first =
       std::lower_bound(warm_.begin(), warm_.end(), std::make_pair(lo, hi),
                        [](const WarmContact& x, const std::pair<dGeomID, dGeomID>& key) {
-                         return std::less<dGeomID>()(x.lo, key.first) ||
-                                (x.lo == key.first && std::less<dGeomID>()(x.hi, key.second));
+                         return pairBefore(x.lo, x.hi, key.first, key.second);
                        });
   const double reach2 = settings_.warm_start_distance * settings_.warm_start_distance;
   for (int i = 0; i < n; ++i) {

@@ -139,9 +139,8 @@ TEST(BowlFeeder, MeshBowlRunsTheSameFromAnyFolder) {
   }
   ASSERT_EQ(series[0].size(), series[1].size());
   for (std::size_t k = 0; k < series[0].size(); ++k) {
-    ASSERT_EQ(series[0][k].mean_velocity, series[1][k].mean_velocity)
-        << "t = " << series[0][k].time;
-    ASSERT_EQ(series[0][k].mean_height, series[1][k].mean_height) << "t = " << series[0][k].time;
+    ASSERT_EQ(series[0][k].mean_velocity, series[1][k].mean_velocity) << "sample " << k;
+    ASSERT_EQ(series[0][k].mean_height, series[1][k].mean_height) << "sample " << k;
   }
 }
 

@@ -323,11 +323,48 @@ struct MeshCollisionScratch {
   }
 };
 
+namespace detail {
+
+/// Triangle `t` of `mesh` (its corners in the world frame, v[0..2], v[3..5], v[6..8]) and its
+/// face normal; false for a degenerate triangle.
+inline bool triangleOf(dGeomID mesh, int t, double v[9], MeshEdges::Normal& f) {
+  dVector3 a, b, c;
+  dGeomTriMeshGetTriangle(mesh, t, &a, &b, &c);
+  const double corners[9] = {a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]};
+  std::copy(corners, corners + 9, v);
+  f = MeshEdges::faceNormal(v);
+  return f.valid;
+}
+
+/// For the triangle v with unit face normal f: how far point p lies inside each edge k (corner k
+/// to k + 1), in the triangle's plane (m; < 0 beyond it; 0 for an edge of length 0), and the
+/// longest edge's length. Returns whether every edge has a length.
+inline bool insideEdges(const double v[9], const MeshEdges::Normal& f, const double p[3],
+                        double inside[3], double& longest) {
+  bool all = true;
+  longest = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double* p0 = v + 3 * k;
+    const double* p1 = v + 3 * ((k + 1) % 3);
+    const double e[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+    const double len = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    longest = std::max(longest, len);
+    all = all && len > 0;
+    // f x e / |e|: the edge's in-plane normal, into the triangle (counter-clockwise corners)
+    const double m[3] = {f.y * e[2] - f.z * e[1], f.z * e[0] - f.x * e[2], f.x * e[1] - f.y * e[0]};
+    inside[k] = len > 0
+                    ? ((p[0] - p0[0]) * m[0] + (p[1] - p0[1]) * m[1] + (p[2] - p0[2]) * m[2]) / len
+                    : 0.0;
+  }
+  return all;
+}
+
+}  // namespace detail
+
 /// A point's place over a fixture mesh's smooth surface (surfacePointOver).
 struct SurfacePoint {
   int triangle = -1;             ///< the triangle under the point
   double normal[3] = {0, 0, 0};  ///< its unit face normal (world, out of the fixture)
-  double corner[3] = {0, 0, 0};  ///< its corner 0 (m, world)
   double height = 0;             ///< the point's height above its plane (m; < 0 below it)
 };
 
@@ -341,34 +378,22 @@ inline bool surfacePointOver(dGeomID mesh, const MeshEdges& edges, int start, co
   int t = start;
   for (int walk = 0; walk < 4; ++walk) {
     if (t < 0 || t >= edges.triangles()) return false;
-    dVector3 a, b, c;
-    dGeomTriMeshGetTriangle(mesh, t, &a, &b, &c);
-    const double v[9] = {a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]};
-    const MeshEdges::Normal f = MeshEdges::faceNormal(v);
-    if (!f.valid) return false;
+    double v[9], inside[3], longest;
+    MeshEdges::Normal f;
+    if (!detail::triangleOf(mesh, t, v, f)) return false;
     const double height = (p[0] - v[0]) * f.x + (p[1] - v[1]) * f.y + (p[2] - v[2]) * f.z;
+    if (!detail::insideEdges(v, f, p, inside, longest)) return false;
     int beyond = -1;
     double farthest = 0;
     for (int k = 0; k < 3; ++k) {
-      const double* p0 = v + 3 * k;
-      const double* p1 = v + 3 * ((k + 1) % 3);
-      const double e[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-      const double len = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-      if (!(len > 0)) return false;
-      // f x e / |e|: the edge's in-plane normal, into the triangle (counter-clockwise corners)
-      const double m[3] = {f.y * e[2] - f.z * e[1], f.z * e[0] - f.x * e[2],
-                           f.x * e[1] - f.y * e[0]};
-      const double inside =
-          ((p[0] - p0[0]) * m[0] + (p[1] - p0[1]) * m[1] + (p[2] - p0[2]) * m[2]) / len;
-      if (inside < farthest) {
-        farthest = inside;
+      if (inside[k] < farthest) {
+        farthest = inside[k];
         beyond = k;
       }
     }
     if (beyond < 0) {
       out.triangle = t;
       out.normal[0] = f.x, out.normal[1] = f.y, out.normal[2] = f.z;
-      out.corner[0] = v[0], out.corner[1] = v[1], out.corner[2] = v[2];
       out.height = height;
       return true;
     }
@@ -476,7 +501,7 @@ inline bool namesTheTriangle(dGeomID partner) {
 /// that triangle can penetrate along the face normal, and so a bound on the contact's depth along
 /// it. Infinite when c names no triangle of a mesh partner.
 inline double partnerTriangleDepthBound(const dContactGeom& c, dGeomID partner, bool partner_is_g1,
-                                        const double* corner, const double* face) {
+                                        const double* corner, const MeshEdges::Normal& face) {
   const int triangle = partner_is_g1 ? c.side1 : c.side2;
   if (dGeomGetClass(partner) != dTriMeshClass || triangle < 0 ||
       triangle >= dGeomTriMeshGetTriangleCount(partner)) {
@@ -486,8 +511,8 @@ inline double partnerTriangleDepthBound(const dContactGeom& c, dGeomID partner, 
   dGeomTriMeshGetTriangle(partner, triangle, &v[0], &v[1], &v[2]);
   double deepest = -std::numeric_limits<double>::infinity();
   for (const dVector3& p : v) {
-    deepest = std::max(deepest, -((p[0] - corner[0]) * face[0] + (p[1] - corner[1]) * face[1] +
-                                  (p[2] - corner[2]) * face[2]));
+    deepest = std::max(deepest, -((p[0] - corner[0]) * face.x + (p[1] - corner[1]) * face.y +
+                                  (p[2] - corner[2]) * face.z));
   }
   return std::max(0.0, deepest);
 }
@@ -510,12 +535,7 @@ inline bool correctInternalEdgeNormal(dContactGeom& c, dGeomID fixture, const Me
   double dist = 0, cos_f = 0;
   const double sign = fixture_is_g2 ? 1.0 : -1.0;  // ODE's normal points out of g2 into g1
   for (int walk = 0;; ++walk) {
-    dVector3 a, b, cc;
-    dGeomTriMeshGetTriangle(fixture, t, &a, &b, &cc);
-    const double corners[9] = {a[0], a[1], a[2], b[0], b[1], b[2], cc[0], cc[1], cc[2]};
-    std::copy(corners, corners + 9, v);
-    f = MeshEdges::faceNormal(v);
-    if (!f.valid) return false;
+    if (!triangleOf(fixture, t, v, f)) return false;
     // ODE's normal turned out of the fixture, against this face's
     cos_f = sign * (c.normal[0] * f.x + c.normal[1] * f.y + c.normal[2] * f.z);
     if (walk == 0 && cos_f >= detail::kCosFaceNormalTolerance) {
@@ -524,8 +544,7 @@ inline bool correctInternalEdgeNormal(dContactGeom& c, dGeomID fixture, const Me
       // the part stands on it (the nut's side or hole), the face normal with the depth of the
       // fixture triangle's far corner behind that standing face: up to a fixture triangle's
       // size (0.96 mm on 1 mm triangles), which kicked a flat nut up and spinning.
-      const double face[3] = {f.x, f.y, f.z};
-      const double bound = partnerTriangleDepthBound(c, partner, fixture_is_g2, v, face);
+      const double bound = partnerTriangleDepthBound(c, partner, fixture_is_g2, v, f);
       if (!(c.depth > bound)) return false;
       c.depth = bound;
       return true;
@@ -535,19 +554,7 @@ inline bool correctInternalEdgeNormal(dContactGeom& c, dGeomID fixture, const Me
     dist = (c.pos[0] - v[0]) * f.x + (c.pos[1] - v[1]) * f.y + (c.pos[2] - v[2]) * f.z;
     const double q[3] = {c.pos[0] - dist * f.x, c.pos[1] - dist * f.y, c.pos[2] - dist * f.z};
     double longest = 0, inside[3];
-    for (int k = 0; k < 3; ++k) {
-      const double* p0 = v + 3 * k;
-      const double* p1 = v + 3 * ((k + 1) % 3);
-      const double e[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-      const double len = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-      longest = std::max(longest, len);
-      // f x e / |e|: the edge's in-plane normal, into the triangle (counter-clockwise corners)
-      const double m[3] = {f.y * e[2] - f.z * e[1], f.z * e[0] - f.x * e[2],
-                           f.x * e[1] - f.y * e[0]};
-      inside[k] =
-          len > 0 ? ((q[0] - p0[0]) * m[0] + (q[1] - p0[1]) * m[1] + (q[2] - p0[2]) * m[2]) / len
-                  : 0.0;
-    }
+    insideEdges(v, f, q, inside, longest);  // an edge of length 0 reads 0: beside it
     // beside an edge: within the contact's depth of it, or 1 % of the triangle's size
     const double near = std::max(std::abs(c.depth), 0.01 * longest);
     int beyond = -1;  // the edge the point lies farthest beyond, when it is off this triangle
@@ -574,9 +581,8 @@ inline bool correctInternalEdgeNormal(dContactGeom& c, dGeomID fixture, const Me
   // and on a curved fixture (the bowl's 4 degree cone) its deepest corner lies below this
   // triangle's plane where the fixture does not; that depth pushed a flat nut up every step and
   // made it hop (demos/results/bowl_feeder.md, section 9).
-  const double face[3] = {f.x, f.y, f.z};
   const double depth = std::min(std::max(-dist, std::abs(c.depth) * std::max(0.0, cos_f)),
-                                partnerTriangleDepthBound(c, partner, fixture_is_g2, v, face));
+                                partnerTriangleDepthBound(c, partner, fixture_is_g2, v, f));
   c.normal[0] = sign * f.x;
   c.normal[1] = sign * f.y;
   c.normal[2] = sign * f.z;

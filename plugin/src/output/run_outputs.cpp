@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "rheofeed/measure/statistics.hpp"
 #include "rheofeed/number_format.hpp"
 #include "rheofeed/output/output.hpp"
 #include "rheofeed/output/plot.hpp"
@@ -22,7 +23,7 @@ std::string seriesCsv(const RunMetrics& run) {
   for (const DriftSample& d : run.series) {
     // the spread of one part (or none) has no confidence interval: the field stays empty
     char ci[32] = "";
-    if (d.parts >= 2) std::snprintf(ci, sizeof ci, "%.8g", d.ci95);
+    if (ci95Defined(d.parts)) std::snprintf(ci, sizeof ci, "%.8g", d.ci95);
     std::snprintf(line, sizeof line, "%.6f,%d,%.8g,%s,%.8g,%d,%d,%d,%d,%d,%d,%d\n", d.time, d.parts,
                   d.mean_velocity, ci, d.mean_height, d.exited, d.fell, d.through_fixture,
                   d.out_of_bounds, d.nonfinite, d.too_fast, d.left_feeder);
@@ -33,7 +34,7 @@ std::string seriesCsv(const RunMetrics& run) {
 
 std::string summaryJson(const RunMetrics& r) {
   char ci[32] = "null";  // no confidence interval over fewer than two parts
-  if (r.parts >= 2) std::snprintf(ci, sizeof ci, "%.8g", r.mean_drift_ci95);
+  if (ci95Defined(r.parts)) std::snprintf(ci, sizeof ci, "%.8g", r.mean_drift_ci95);
   char b[768];
   std::snprintf(b, sizeof b,
                 ", \"method\": \"%s\", \"time_step_s\": %.8g, \"parts\": %d, "
@@ -127,7 +128,7 @@ std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::strin
      << " s, " << run.parts << " parts'\n"
      << "plot ";
   // the band only where there is one (two parts or more; the CSV's field is empty otherwise)
-  if (run.parts >= 2) {
+  if (ci95Defined(run.parts)) {
     gp << "$data using 1:($3-$4):($3+$4) with filledcurves fc rgb '#c0d0f0' title '95 % CI', ";
   }
   gp << "$data using 1:3 with lines lw 2 lc rgb '#1040a0' title 'mean over parts'\n";

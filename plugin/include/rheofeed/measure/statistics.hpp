@@ -23,4 +23,10 @@ double studentT95(int dof);
 /// fewer than two values.
 double ci95(const std::vector<double>& values);
 
+/// Whether ci95 over `count` values is defined: two or more (one value has no spread; the
+/// outputs write null, an empty field or n/a instead of ci95's 0).
+inline bool ci95Defined(int count) {
+  return count >= 2;
+}
+
 }  // namespace rheofeed::scene
