@@ -7,7 +7,7 @@
 #                              [PACKAGES <package>...])
 # installs <target>s in the export set of component <name>. COMPONENTS are the components these
 # targets link (declared before this one), PACKAGES the external packages their exported link
-# interface names (known to rheofeedConfig.cmake.in: ODE, Eigen3, nlohmann_json, assimp,
+# interface names (known to rheofeedConfig.cmake.in: ODE, Eigen3, nlohmann_json, assimp, Qhull,
 # TinyGLTF, Threads).
 # A new library joins an existing component (add it to TARGETS) or gets a component of its own.
 #
@@ -21,7 +21,7 @@ include(GNUInstallDirs)
 set(RHEOFEED_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/rheofeed)
 set(RHEOFEED_PACKAGE_TABLE "")
 set(RHEOFEED_PACKAGE_COMPONENTS "")
-set(RHEOFEED_PACKAGE_KNOWN_PACKAGES ODE Eigen3 nlohmann_json assimp TinyGLTF Threads)
+set(RHEOFEED_PACKAGE_KNOWN_PACKAGES ODE Eigen3 nlohmann_json assimp Qhull TinyGLTF Threads)
 
 function(rheofeed_package_component name)
   cmake_parse_arguments(PARSE_ARGV 1 arg "" "" "TARGETS;COMPONENTS;PACKAGES")

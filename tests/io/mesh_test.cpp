@@ -181,6 +181,50 @@ TEST(DemoMeshes, HexNutIsClosedWithPrismMinusHoleVolume) {
   EXPECT_GT(p.inertia[8], p.inertia[0]);  // flat: the axis has the largest moment
 }
 
+// The nut's convex hull is the plain hexagonal prism: its hole and the points that cut its
+// sides are dropped, its coplanar faces merged (6 sides of 2 triangles, 2 hexagons of 4), and
+// it is a closed outward solid of the prism's volume with every nut vertex inside or on it.
+TEST(DemoMeshes, HexNutsConvexHullIsThePlainPrism) {
+  const TriangleMesh nut = loadTriangleMesh(kDemoMeshes / "hex_nut_m6.obj");
+  const TriangleMesh hull = convexHull(nut);
+  const double flats = 10, thickness = 5;
+  const double volume = 3 * std::sqrt(3.0) / 2 * std::pow(flats / std::sqrt(3.0), 2) * thickness;
+  EXPECT_EQ(hull.vertices.size() / 3, 12u);
+  EXPECT_EQ(hull.triangles.size() / 3, 20u);
+  const MassProperties p = massProperties(hull, 1.0);  // throws if open or inside out
+  EXPECT_NEAR(p.volume, volume, 1e-6 * volume);
+  EXPECT_NEAR(norm(p.centre_of_mass), 0.0, 1e-6);
+  EXPECT_NE(hull.source.find("hex_nut_m6.obj"), std::string::npos) << hull.source;
+  // Every nut vertex lies on the inner side of every hull face's plane.
+  for (std::size_t t = 0; t < hull.triangles.size(); t += 3) {
+    auto at = [&](int k) {
+      const double* v = &hull.vertices[3 * static_cast<std::size_t>(hull.triangles[t + k])];
+      return Vec3{v[0], v[1], v[2]};
+    };
+    const Vec3 n = cross(at(1) - at(0), at(2) - at(0));
+    for (std::size_t v = 0; v < nut.vertices.size(); v += 3) {
+      const Vec3 x{nut.vertices[v], nut.vertices[v + 1], nut.vertices[v + 2]};
+      EXPECT_LE(dot(x - at(0), n) / norm(n), 1e-6) << "nut vertex " << v / 3 << ", face " << t / 3;
+    }
+  }
+}
+
+// A hull of points on one plane has no volume: refused, naming the mesh and quoting qhull.
+TEST(MeshHull, FlatOrTooFewVerticesAreRefusedByName) {
+  TriangleMesh flat;
+  flat.source = "flat.stl";
+  flat.vertices = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0.5, 0.5, 0};
+  flat.triangles = {0, 1, 2, 0, 2, 3};
+  expectThrowWith<std::invalid_argument>([&] { convexHull(flat); },
+                                         {"flat.stl", "no convex hull", "qhull"});
+  flat.vertices.resize(9);
+  expectThrowWith<std::invalid_argument>([&] { convexHull(flat); },
+                                         {"flat.stl", "at least 4 vertices", "has 3"});
+  TriangleMesh bad = flat;
+  bad.vertices = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, NAN};
+  expectThrowWith<std::invalid_argument>([&] { convexHull(bad); }, {"vertex 3", "non-finite"});
+}
+
 TEST(DemoMeshes, BowlLoadsAsClosedShellsWithinTheCommitBudget) {
   const fs::path file = kDemoMeshes / "vibratory_bowl.stl";
   const TriangleMesh bowl = loadTriangleMesh(file, 0.001);

@@ -127,6 +127,7 @@ void expectSameScene(const Scene& a, const Scene& b) {
     for (int d = 0; d < n; ++d) expectSame(pa.size[d], pb.size[d], w + ".size");
     if (pa.shape == Shape::Kind::Mesh) {
       EXPECT_EQ(pa.mesh, pb.mesh) << w;
+      EXPECT_EQ(pa.collision, pb.collision) << w;
     }
     EXPECT_EQ(pa.density, pb.density) << w;
     expectSame(pa.spawn_min, pb.spawn_min, w + ".spawn_min");
@@ -285,6 +286,7 @@ Scene everyFieldScene() {
   nuts.mesh = "/meshes/nut.obj";
   nuts.size[0] = {0.5, 0.05, 0.4, 0.6};
   nuts.density = 7850;
+  nuts.collision = PartSpec::Collision::ConvexHull;
   nuts.spawn_min = {-3, 0, 1};
   nuts.spawn_max = {-2.5, 0.5, 1.5};
   nuts.count = 4;
@@ -333,6 +335,32 @@ TEST(SceneFile, PartMeshIsCentredOnItsCentreOfMass) {
   // The fixture mesh keeps its own frame, scaled by 0.001.
   const MassProperties f = massProperties(*back.fixtures[2].geoms[0].shape.mesh_data, 1.0);
   EXPECT_NEAR(f.centre_of_mass.x, 0.1e-3, 1e-9);
+}
+
+// A part colliding as its convex hull keeps its own mesh for mass and drawing; the hull (of the
+// test box: itself, 12 triangles) is built once in the same centred frame, and every drawn part
+// collides with a copy scaled as its mesh.
+TEST(SceneFile, ConvexHullPartsCollideWithTheHullScaledAsTheirMesh) {
+  const Scene back = parseScene(toJson(everyFieldScene()), "x.json", CountingLoader{}.loader());
+  const PartSpec& nuts = back.parts[3];
+  ASSERT_EQ(nuts.collision, PartSpec::Collision::ConvexHull);
+  ASSERT_TRUE(nuts.collision_mesh_data);
+  EXPECT_EQ(nuts.collision_mesh_data->triangles.size(), 36u);
+  const MassProperties mesh = massProperties(*nuts.mesh_data, 1.0);
+  const MassProperties hull = massProperties(*nuts.collision_mesh_data, 1.0);
+  EXPECT_NEAR(hull.volume, mesh.volume, 1e-12 * mesh.volume);  // a box is its own hull
+  EXPECT_NEAR(norm(hull.centre_of_mass), 0.0, 1e-12);
+  EXPECT_NE(nuts.collision_mesh_data->source.find("convex hull of"), std::string::npos);
+  for (const PartInstance& p : drawParts(back)) {
+    if (p.spec != 3) {
+      EXPECT_FALSE(p.shape.collision_mesh_data);
+      continue;
+    }
+    ASSERT_TRUE(p.shape.collision_mesh_data);
+    EXPECT_NEAR(boundingRadius(*p.shape.collision_mesh_data), boundingRadius(*p.shape.mesh_data),
+                1e-12);
+    EXPECT_NEAR(p.mass, 7850 * mesh.volume * std::pow(p.shape.mesh_scale, 3), 1e-9 * p.mass);
+  }
 }
 
 TEST(SceneFile, SceneWithoutMeshesNeverCallsTheMeshLoader) {
@@ -630,6 +658,14 @@ TEST(SceneFileErrors, BadLawAndShapeNamesAreExplained) {
           "needs an array of 1");
   refused(replaced(kGood, R"("duration": 1)", R"("duration": 1, "format_version": 2)"),
           "format_version", "reads version 1");
+  refused(replaced(kGood, R"("shape": "sphere")", R"("shape": "sphere", "collision": "mesh")"),
+          "parts[1].collision", "only mesh parts choose what they collide as (a sphere part");
+}
+
+TEST(SceneFileErrors, BadCollisionNameIsExplained) {
+  const std::string text = R"({"parts": [{"shape": "mesh", "mesh": "nut.obj", "collision": "hull",
+                                 "spawn_min": [0, 0, 1], "spawn_max": [0, 0, 1]}]})";
+  refused(text, "parts[0].collision", "must be \"mesh\" or \"convex_hull\", got \"hull\"");
 }
 
 TEST(SceneFileErrors, UnknownBroadPhaseIsExplained) {

@@ -10,12 +10,17 @@
 #include <algorithm>
 #include <assimp/Importer.hpp>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
 
 #include "rheofeed/number_format.hpp"
+
+// Last: qhull's headers define macros (True, False, FORALLfacets, ...).
+#include <libqhull_r/qhull_ra.h>
 
 namespace rheofeed::scene {
 namespace {
@@ -243,6 +248,85 @@ TriangleMesh translateMesh(const TriangleMesh& mesh, const Vec3& offset) {
     out.vertices[i + 2] += offset.z;
   }
   return out;
+}
+
+TriangleMesh convexHull(const TriangleMesh& mesh) {
+  const std::string name = nameOf(mesh);
+  if (mesh.vertices.size() % 3 != 0 || mesh.vertices.size() < 12) {
+    throw std::invalid_argument(name + ": a convex hull needs at least 4 vertices, the mesh has " +
+                                std::to_string(mesh.vertices.size() / 3));
+  }
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    if (!std::isfinite(mesh.vertices[i])) {
+      throw std::invalid_argument(name + ": vertex " + std::to_string(i / 3) +
+                                  " has a non-finite coordinate");
+    }
+  }
+  std::vector<coordT> points(mesh.vertices.begin(), mesh.vertices.end());
+  // qhull's messages go to a memory stream, quoted in the exception; nothing reaches stderr.
+  char* message = nullptr;
+  std::size_t message_size = 0;
+  FILE* err = open_memstream(&message, &message_size);
+  if (!err) throw std::runtime_error(name + ": convex hull: cannot open a message stream");
+  qhT qh_storage;
+  qhT* qh = &qh_storage;
+  QHULL_LIB_CHECK
+  qh_zero(qh, err);
+  // Facets within a millionth of the mesh's size of coplanar are merged ('C-n'): a flat face
+  // is one polygon even where the file rounded the points along its edges (an OBJ's 6 decimals).
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    lo[i % 3] = std::min(lo[i % 3], points[i]);
+    hi[i % 3] = std::max(hi[i % 3], points[i]);
+  }
+  char command[64];
+  std::snprintf(command, sizeof command, "qhull C-%.3g",
+                1e-6 * std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
+  const int exit_code = qh_new_qhull(qh, 3, static_cast<int>(points.size() / 3), points.data(),
+                                     False, command, nullptr, err);
+  TriangleMesh hull;
+  hull.source = "convex hull of " + (mesh.source.empty() ? std::string("a mesh") : mesh.source);
+  if (exit_code == 0) {
+    std::vector<int> index(points.size() / 3, -1);  // qhull point id -> hull vertex
+    auto vertexOf = [&](const vertexT* v) {
+      const int id = qh_pointid(qh, v->point);
+      if (index[static_cast<std::size_t>(id)] < 0) {
+        index[static_cast<std::size_t>(id)] = static_cast<int>(hull.vertices.size() / 3);
+        hull.vertices.insert(hull.vertices.end(), v->point, v->point + 3);
+      }
+      return index[static_cast<std::size_t>(id)];
+    };
+    auto at = [&hull](int k) { return vertex(hull, k); };
+    facetT* facet;
+    FORALLfacets {
+      // The facet's vertices in order round it; fanned into triangles turned to face outwards.
+      setT* ring = qh_facet3vertex(qh, facet);
+      std::vector<int> polygon;
+      vertexT *vertex, **vertexp;
+      FOREACHvertex_(ring) polygon.push_back(vertexOf(vertex));
+      qh_settempfree(qh, &ring);
+      if (polygon.size() < 3) continue;
+      const Vec3 n{facet->normal[0], facet->normal[1], facet->normal[2]};
+      const bool outward =
+          dot(cross(at(polygon[1]) - at(polygon[0]), at(polygon[2]) - at(polygon[0])), n) > 0;
+      for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {
+        const int b = polygon[outward ? k : k + 1], c = polygon[outward ? k + 1 : k];
+        hull.triangles.insert(hull.triangles.end(), {polygon[0], b, c});
+      }
+    }
+  }
+  int still_long = 0, still_total = 0;
+  qh_freeqhull(qh, !qh_ALL);
+  qh_memfreeshort(qh, &still_long, &still_total);
+  std::fclose(err);
+  std::string text(message ? message : "", message_size);
+  std::free(message);
+  if (exit_code != 0 || hull.triangles.empty()) {
+    const std::size_t end = text.find('\n', text.find_first_not_of(" \n"));
+    throw std::invalid_argument(name + ": no convex hull (the vertices span no volume?): qhull: " +
+                                text.substr(0, std::min(end, std::size_t{300})));
+  }
+  return hull;
 }
 
 double boundingRadius(const TriangleMesh& mesh) {

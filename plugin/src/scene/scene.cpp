@@ -598,7 +598,7 @@ std::vector<PartInstance> drawParts(const Scene& scene) {
     // Mesh parts: mass properties at scale 1 (mesh.hpp), and one scaled mesh per drawn scale.
     MassProperties unit_mesh;
     double unit_radius = 0;
-    std::map<double, std::shared_ptr<const TriangleMesh>> scaled_meshes;
+    std::map<double, std::shared_ptr<const TriangleMesh>> scaled_meshes, scaled_hulls;
     if (spec.shape == Shape::Kind::Mesh) {
       if (!spec.mesh_data) {
         throw std::invalid_argument("parts[" + std::to_string(s) + "].mesh: '" + spec.mesh +
@@ -652,6 +652,14 @@ std::vector<PartInstance> drawParts(const Scene& scene) {
           p.shape.mesh = spec.mesh;
           p.shape.mesh_scale = scale;
           p.shape.mesh_data = mesh;
+          if (spec.collision_mesh_data) {
+            std::shared_ptr<const TriangleMesh>& hull = scaled_hulls[scale];
+            if (!hull) {
+              hull =
+                  std::make_shared<const TriangleMesh>(scaleMesh(*spec.collision_mesh_data, scale));
+            }
+            p.shape.collision_mesh_data = hull;
+          }
           const MassProperties mp = scaleMassProperties(unit_mesh, scale);
           const double* in = mp.inertia;
           dMassSetParameters(&m, mp.mass, 0, 0, 0, in[0], in[4], in[8], in[1], in[2], in[5]);

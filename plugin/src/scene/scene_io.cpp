@@ -512,6 +512,19 @@ PartSpec readPart(const json& v, const std::string& path) {
     if (p.mesh.empty()) fail(o.at("mesh"), "empty file name");
     p.size[0] = Distribution{};
     p.size[0].mean = 1.0;  // the scale factor
+    if (const json* c = o.find("collision")) {
+      if (*c == "mesh") {
+        p.collision = PartSpec::Collision::Mesh;
+      } else if (*c == "convex_hull") {
+        p.collision = PartSpec::Collision::ConvexHull;
+      } else {
+        fail(o.at("collision"), "must be \"mesh\" or \"convex_hull\", got " + describe(*c));
+      }
+    }
+  }
+  if (p.shape != Shape::Kind::Mesh && o.find("collision")) {
+    fail(o.at("collision"), std::string("only mesh parts choose what they collide as (a ") +
+                                toString(p.shape) + " part collides as itself)");
   }
   const json* size = p.shape == Shape::Kind::Mesh ? o.find("size") : &o.require("size");
   if (size) {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Scene files, the meshes they name (scene_io.hpp, loadSceneMeshes): loaded once per file and
 // scale, fixture meshes checked against the size and coordinate limits, part meshes centred
-// on their centre of mass.
+// on their centre of mass (and their convex hulls built for parts that collide as one).
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -93,6 +93,9 @@ void loadSceneMeshes(Scene& scene, const fs::path& base_dir, const MeshLoader& m
     try {  // a part must be a closed, outward-oriented solid; centre it on its centre of mass
       const MassProperties mp = massProperties(*mesh, 1.0);
       p.mesh_data = std::make_shared<const TriangleMesh>(translateMesh(*mesh, -mp.centre_of_mass));
+      if (p.collision == PartSpec::Collision::ConvexHull) {
+        p.collision_mesh_data = std::make_shared<const TriangleMesh>(convexHull(*p.mesh_data));
+      }
     } catch (const std::exception& e) {
       fail(path, e.what());
     }

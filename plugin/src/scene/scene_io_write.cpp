@@ -145,7 +145,10 @@ ojson toJson(const FeederLaw& law, const std::vector<PartSpec>& parts) {
 
 ojson toJson(const PartSpec& p) {
   ojson out{{"name", p.name}, {"shape", toString(p.shape)}};
-  if (p.shape == Shape::Kind::Mesh) out["mesh"] = p.mesh;
+  if (p.shape == Shape::Kind::Mesh) {
+    out["mesh"] = p.mesh;
+    out["collision"] = p.collision == PartSpec::Collision::ConvexHull ? "convex_hull" : "mesh";
+  }
   ojson size = ojson::array();
   for (int d = 0; d < partSizeCount(p.shape); ++d) size.push_back(toJson(p.size[d]));
   out["size"] = size;

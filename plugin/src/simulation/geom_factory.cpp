@@ -73,7 +73,9 @@ dGeomID createGeom(dSpaceID space, const Shape& s, TriMeshStore& meshes) {
                                     "' is not loaded (load the scene with loadScene, or call "
                                     "loadSceneMeshes; scene_io.hpp)");
       }
-      return dCreateTriMesh(space, meshes.data(s.mesh_data), nullptr, nullptr, nullptr);
+      return dCreateTriMesh(
+          space, meshes.data(s.collision_mesh_data ? s.collision_mesh_data : s.mesh_data), nullptr,
+          nullptr, nullptr);
   }
   throw std::invalid_argument("unknown shape kind");
 }

@@ -40,8 +40,9 @@ class TriMeshStore {
 };
 
 /// Creates the geom of `shape` in `space` (no body, identity pose). Planes use their world
-/// equation. Meshes are built from shape.mesh_data (already scaled; filled by the scene loader)
-/// with their ODE data owned by `meshes`; a mesh shape without mesh_data throws
+/// equation. Meshes are built from shape.collision_mesh_data when set (a part colliding as its
+/// convex hull), else from shape.mesh_data (already scaled; filled by the scene loader), with
+/// their ODE data owned by `meshes`; a mesh shape without mesh_data throws
 /// std::invalid_argument.
 dGeomID createGeom(dSpaceID space, const Shape& shape, TriMeshStore& meshes);
 

@@ -60,6 +60,18 @@ TriangleMesh scaleMesh(const TriangleMesh& mesh, double scale);
 /// A copy of `mesh` moved by `offset` (m): every vertex v becomes v + offset.
 TriangleMesh translateMesh(const TriangleMesh& mesh, const Vec3& offset);
 
+/// The convex hull of `mesh`'s vertices (qhull) as a closed triangle mesh, outward
+/// (counter-clockwise seen from outside), in the same frame and units; `source` is
+/// "convex hull of <mesh.source>". Coplanar faces are merged before they are triangulated, so a
+/// hexagonal prism gives 20 triangles however finely its sides were cut, and vertices that are
+/// not hull corners (a nut's hole, points along an edge) are dropped. Used to collide a part as
+/// its hull (PartSpec::collision) while its mass comes from the mesh itself.
+///
+/// Throws std::invalid_argument naming `mesh.source` when the mesh has fewer than 4 vertices,
+/// a non-finite coordinate, or no volume (all vertices on one plane or line: qhull's message
+/// is quoted).
+TriangleMesh convexHull(const TriangleMesh& mesh);
+
 /// The largest distance of a vertex from the mesh origin (m); 0 for an empty mesh.
 double boundingRadius(const TriangleMesh& mesh);
 

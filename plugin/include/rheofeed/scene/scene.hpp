@@ -55,6 +55,10 @@ struct Shape {
   /// Mesh: the loaded triangles (already scaled), filled by the scene loader (scene_io.hpp);
   /// geoms are built from it, so a scene without meshes never loads any.
   std::shared_ptr<const TriangleMesh> mesh_data;
+  /// Mesh parts colliding as their convex hull (PartSpec::Collision::ConvexHull): the hull,
+  /// scaled as mesh_data, which the engines collide instead of it; null: they collide
+  /// mesh_data. Drawings and mass properties always use mesh_data.
+  std::shared_ptr<const TriangleMesh> collision_mesh_data;
 };
 
 /// Printable name of a shape kind ("box", "sphere", ...).
@@ -170,6 +174,15 @@ struct PartSpec {
   std::string mesh;      ///< Mesh parts: file (assimp); size[0] is the scale factor
   /// Mesh parts: loaded triangles at scale 1, centred on their centre of mass (scene loader).
   std::shared_ptr<const TriangleMesh> mesh_data;
+  /// Mesh parts: what the engines collide. Mesh: the mesh itself. ConvexHull: its convex hull
+  /// (convexHull, mesh.hpp; JSON "collision": "convex_hull"): holes and recesses filled, coplanar
+  /// faces merged, so ODE's trimesh-trimesh test has far fewer triangles to try (an M6 nut: 20
+  /// instead of 192); mass and inertia still come from the mesh. For parts whose recesses
+  /// nothing in the scene can enter.
+  enum class Collision { Mesh, ConvexHull };
+  Collision collision = Collision::Mesh;
+  /// ConvexHull: the hull of mesh_data (scale 1, the same frame), filled by the scene loader.
+  std::shared_ptr<const TriangleMesh> collision_mesh_data;
   double density = 7800;  ///< (kg/m^3, in [1e-3, 1e6])
   /// Spawn region, axis-aligned box (m, world; coordinates in [-1e6, 1e6], spawn_min <=
   /// spawn_max per axis).
