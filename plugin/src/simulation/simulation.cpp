@@ -40,20 +40,35 @@
 // tests stay below (RunHealth::max_speed_ratio in their JSON).
 //
 // ## Tunnelling
-// A part's centre never reaches a fixture surface in contact (it stays at least its smallest
-// half-size away, less the penetration). When it moves by more than kTunnelCheckFraction of
-// that half-size in one step, an ODE ray from its old centre to its new one is collided with
-// every fixture geom whose box it overlaps (at the geoms' current poses); slower crossings need
-// a centre already sunk by more than 3/4 of its half-size. If the ray crosses a surface:
-// - and the reverse ray (new to old centre) crosses one elsewhere, the centre went into a
+// The checks follow one point of each part, its anchor (partAnchor): the centre of mass,
+// unless that lies outside the part's own solid (a hex nut's is in its hole), when it is a point
+// deep inside the material. The anchor never reaches a fixture surface in contact: it stays at
+// least its clearance away, less the penetration; the clearance is the smallest half-size for
+// a centre of mass (a primitive, or a mesh whose centre is inside its closed mesh) and the
+// anchor's distance to the part's surface otherwise. When the anchor moves by more than
+// kTunnelCheckFraction of its clearance in one step, an ODE ray from its old position to its
+// new one is collided with every fixture geom whose box it overlaps (at the geoms' current
+// poses); a slower crossing needs an anchor already sunk by nearly its whole clearance. If the
+// ray crosses a surface:
+// - and the reverse ray (new to old anchor) crosses one elsewhere, the anchor went into a
 //   fixture and out again within the step: through (a thin floor jumped over);
-// - else the centre is now inside a fixture (or behind a mesh sheet): the entry point and the
+// - else the anchor is now inside a fixture (or behind a mesh sheet): the entry point and the
 //   entry surface's outward normal are kept and the part's rays are cast every step until its
-//   centre crosses a surface again: on the outer side of the entry surface's plane, or out
+//   anchor crosses a surface again: on the outer side of the entry surface's plane, or out
 //   through a surface that does not face away from the entry surface (kThroughCosine: a
 //   corner cut, into a wall's face near its edge and out under it), is a deep penetration that
 //   recovered (parts_sunk); out on the far side is a pass through (parts_through_fixture);
 //   leaving the scene while inside is a pass through too.
+// A centre of mass outside the solid would break the first rule: a nut threaded on a pin has
+// its centre inside the pin, at rest. Its anchor is found once per part from its collision mesh
+// (the convex hull for a part that collides as its hull, which holds its centre): the origin
+// is inside when the mesh's generalized winding number there is above 1/2 (the solid angle the
+// triangles subtend, summed, over 4 pi: 1 inside a closed outward mesh, 0 outside, whatever
+// the mesh's edges and vertices); otherwise rays from the origin along the 26 directions of a
+// cube's faces, edges and corners are cut by the mesh, the midpoints of the spans between
+// consecutive crossings that are inside (winding number) are the candidates, and the one
+// farthest from the nearest triangle is the anchor. The M6 nut's is midway between its hole
+// and an outer corner, about 1.2 mm deep (2.5 mm is its smallest half-size).
 // Every part counted is also recorded (RunHealth::part_events: when, where, which fixture).
 #include "rheofeed/simulation/simulation.hpp"
 
@@ -61,9 +76,11 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "check_internal.hpp"
 #include "rheofeed/contact_collider.hpp"
@@ -75,11 +92,11 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kMinMargin = 1.0;             // m: smallest margin around the scene's extent
-constexpr double kTunnelCheckFraction = 1e-3;  // of the smallest half-size, see above
+constexpr double kTunnelCheckFraction = 1e-3;  // of the anchor's clearance, see above
 // Two crossings along one segment are distinct when they are this far apart (m): far below any
 // part or fixture size, far above the round-off of a ray test over a step.
 constexpr double kCrossingTolerance = 1e-9;
-// A centre that went into a fixture and out again passed through it when the exit surface faces
+// An anchor that went into a fixture and out again passed through it when the exit surface faces
 // away from the entry surface: their outward normals more than 120 degrees apart (cosine below
 // -kThroughCosine). Out through a face at a right angle to the entry is a corner cut.
 constexpr double kThroughCosine = 0.5;
@@ -178,7 +195,8 @@ double surfaceSpeed(const FeederLaw& law, const Bounds& b) {
   return 0;
 }
 
-// Smallest half-size (m) and bounding radius about the centre of mass (m) of a part.
+}  // namespace
+
 void partSizes(const Shape& s, double& min_half, double& radius) {
   switch (s.kind) {
     case Shape::Kind::Box:
@@ -215,8 +233,6 @@ void partSizes(const Shape& s, double& min_half, double& radius) {
   }
   min_half = radius = 0;
 }
-
-}  // namespace
 
 std::string formatPosition(const Vec3& x) {
   char b[96];
@@ -410,7 +426,12 @@ void PartSimulation::spawnDue() {
     const PartInstance& p = instances_[next_++];
     addPart(p);
     Track tr;
-    partSizes(p.shape, tr.min_half_size, tr.radius);
+    double min_half = 0;  // partAnchor's clearance for a centre of mass
+    partSizes(p.shape, min_half, tr.radius);
+    const PartAnchor anchor = partAnchor(p.shape);
+    tr.anchor = anchor.point;
+    tr.off_centre = anchor.point != Vec3{};
+    tr.clearance = anchor.clearance;
     tr.last = partState(static_cast<int>(tracks_.size()));
     tr.beyond_exit = beyondExitPlane(scene_.outputs, tr.last.position);
     tracks_.push_back(tr);
@@ -480,9 +501,19 @@ bool PartSimulation::insideFixture(const Vec3& x, bool* unknown) const {
   return false;
 }
 
-void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const PartState& s) {
+Vec3 PartSimulation::anchorAt(std::size_t i, const PartState& s) const {
+  const Track& tr = tracks_[i];
+  if (!tr.off_centre) return s.position;
+  const double* r = s.rotation;  // body to world, row-major
+  const Vec3& a = tr.anchor;
+  return s.position + Vec3{r[0] * a.x + r[1] * a.y + r[2] * a.z,
+                           r[3] * a.x + r[4] * a.y + r[5] * a.z,
+                           r[6] * a.x + r[7] * a.y + r[8] * a.z};
+}
+
+void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const Vec3& to,
+                                    const PartState& s) {
   Track& tr = tracks_[i];
-  const Vec3 to = s.position;
   const double length = norm(to - from);
   Vec3 normal;
   int fixture = -1;
@@ -500,7 +531,7 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const PartS
                 health_.parts_through_fixture, s);
       return;
     }
-    tr.inside = true;  // the centre is inside a fixture now
+    tr.inside = true;  // the anchor is inside a fixture now
     tr.outside_point = from;
     tr.entry_point = from + forward * u;
     tr.entry_normal = dot(normal, u) < 0 ? normal : -normal;  // outward: against the motion
@@ -526,7 +557,7 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const PartS
   if (dot(to - tr.entry_point, tr.entry_normal) > 0 ||
       dot(exit_normal, tr.entry_normal) > -kThroughCosine) {
     // ... but it may have travelled inside the fixture past another one (a plate sunk into a
-    // belt that slides under a wall standing on it): the straight path from its last centre
+    // belt that slides under a wall standing on it): the straight path from its last anchor
     // outside to this one then crosses that other geom in and out (crossing the geom it sank
     // into is the corner cut above).
     const double span = norm(to - tr.outside_point);
@@ -543,14 +574,20 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const PartS
       tr.sunk_counted = true;
       ++health_.parts_sunk;
       const bool corner = dot(to - tr.entry_point, tr.entry_normal) <= 0;
-      const std::string what = corner ? "went into a fixture and came out on a face beside the "
-                                        "one it entered (a corner cut, deeper than half the part)"
-                                      : "went into a fixture and came back out (a penetration "
-                                        "deeper than half the part)";
+      // A centre sinks by more than the smallest half-size; an off-centre anchor by more than
+      // its depth in the part.
+      std::string what = corner ? "went into a fixture and came out on a face beside the one it "
+                                  "entered (a corner cut, "
+                                : "went into a fixture and came back out (a penetration ";
+      what += tr.off_centre ? "deeper than the part's anchor lies in it)"
+                            : "deeper than half the part)";
       recordEvent(i, "sunk", what, s);
       std::ostringstream line;
-      line << "part " << i << "'s centre " << what << " at t = " << time_
-           << " s, x = " << formatPosition(to);
+      line << "part " << i
+           << (tr.off_centre ? "'s anchor (a point inside its material: its centre of mass lies "
+                               "outside it) "
+                             : "'s centre ")
+           << what << " at t = " << time_ << " s, x = " << formatPosition(to);
       reportFirst("part sunk into a fixture", line.str());
     }
     return;
@@ -677,10 +714,11 @@ void PartSimulation::step() {
     }
     checkPhysicalSpeed(i, s);
     tr.beyond_exit = tr.beyond_exit || beyondExitPlane(scene_.outputs, s.position);
-    if (!tr.counted && !tr.beyond_exit &&
-        (tr.inside ||
-         norm(s.position - tr.last.position) > kTunnelCheckFraction * tr.min_half_size)) {
-      trackCrossings(i, tr.last.position, s);
+    if (!tr.counted && !tr.beyond_exit) {
+      const Vec3 from = anchorAt(i, tr.last), to = anchorAt(i, s);
+      if (tr.inside || norm(to - from) > kTunnelCheckFraction * tr.clearance) {
+        trackCrossings(i, from, to, s);
+      }
     }
     std::string where;
     if (!tr.counted && !tr.beyond_exit && leftFeeder(i, s, where)) {

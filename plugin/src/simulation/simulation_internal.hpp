@@ -20,6 +20,10 @@ struct FixtureContact {
   Vec3 normal_on_part;  ///< unit contact normal pushing the part (world)
 };
 
+/// Smallest half-size (m) and bounding radius about the centre of mass (m) of a part of shape
+/// `s` (a mesh: of its bounding box and its farthest vertex; 0 for a plane).
+void partSizes(const Shape& s, double& min_half, double& radius);
+
 /// What the ODE and the reference simulations share: the parts drawn from the scene, spawning
 /// them when due, the checks after each step that take out and count lost parts (RunHealth),
 /// the tunnelling test against the fixture geoms, time keeping. An engine implements the
@@ -88,20 +92,24 @@ class PartSimulation : public Simulation {
 
  private:
   struct Track {
-    PartState last;            // state after the previous check (finite)
-    double min_half_size = 0;  // smallest half-size of the part (m)
-    double radius = 0;         // bounding radius about the centre of mass (m)
+    PartState last;  // state after the previous check (finite)
+    // The point the tunnelling test follows (partAnchor): body frame (m); off_centre when it is
+    // not the centre of mass (the messages then name it); its clearance (m).
+    Vec3 anchor;
+    bool off_centre = false;
+    double clearance = 0;
+    double radius = 0;  // bounding radius about the centre of mass (m)
     bool active = true;
     bool engine_nonfinite = false;  // the engine reported the state non-finite (markNonFinite)
     bool beyond_exit = false;       // has been beyond the exit plane
     bool counted = false;           // counted in a RunHealth loss (or as an exit) already
     bool sunk_counted = false;      // counted in parts_sunk already
-    // Centre inside a fixture: where it entered (m) and the entry surface's outward normal.
+    // Anchor inside a fixture: where it entered (m) and the entry surface's outward normal.
     bool inside = false;
     Vec3 entry_point, entry_normal;
     int entry_fixture = -1;        // the fixture it went into (index in the scene), -1 unknown
     dGeomID entry_geom = nullptr;  // ... and the geom
-    Vec3 outside_point;            // the last centre outside before it went in (m)
+    Vec3 outside_point;            // the last anchor outside before it went in (m)
     // Left the feeder (RunHealth): touched a feeder; fixtures that supported it before that;
     // a fixture not among its carriers supported it in the last step.
     bool on_feeder = false;
@@ -130,8 +138,11 @@ class PartSimulation : public Simulation {
   // capsule, plane: yes/no); `unknown` is set when x lies in the bounding box of a geom it cannot
   // test (cylinder, mesh), where the ray parity of trackCrossings decides instead.
   bool insideFixture(const Vec3& x, bool* unknown) const;
-  // The tunnelling test of part i moving from `from` to state s (simulation.cpp).
-  void trackCrossings(std::size_t i, const Vec3& from, const PartState& s);
+  // Where part i's anchor is (m, world) in state s: position + R anchor.
+  Vec3 anchorAt(std::size_t i, const PartState& s) const;
+  // The tunnelling test of part i, whose anchor moved from `from` to `to` (m, world) in a step
+  // that left it in state s (simulation.cpp).
+  void trackCrossings(std::size_t i, const Vec3& from, const Vec3& to, const PartState& s);
   // Takes part i out, parked at `park`, and counts it under `check` (unless counted already);
   // `state` is the state that failed the check.
   void remove(std::size_t i, PartCheck check, const PartState& state, const PartState& park);

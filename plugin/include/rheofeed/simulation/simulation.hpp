@@ -73,6 +73,16 @@ struct PartEvent {
 /// line). The part is counted (parts_left_feeder), reported with where it crossed, and kept.
 /// Parts that never touch a feeder are not followed (a scene without feeders never counts).
 ///
+/// ## Through a fixture, sunk, inside a fixture: the part's anchor
+/// These three follow one point of each part, its anchor (partAnchor): the centre of mass, which
+/// stays at least the smallest half-size from a fixture surface in contact, or, for a mesh part
+/// whose centre of mass lies outside its own solid (a nut's, in its hole: threaded on a pin, its
+/// centre is inside the pin, at rest), a point deep inside its material, which stays at least
+/// its distance to the part's surface (its clearance) from a fixture surface in contact. An
+/// anchor that crosses a fixture surface is a part that tunnelled or sank. Positions reported
+/// (PartEvent::position, stderr) are the centre's; the stderr line of a sunk part gives the
+/// anchor's where it is not the centre.
+///
 /// ## Too fast (issue 20)
 /// Each part is checked against its own physical speed bound (partPhysicalSpeedBound): its
 /// speed with the kinetic energy in translation, sqrt(|v|^2 + w.I w / m), may not exceed
@@ -94,22 +104,23 @@ struct RunHealth {
   /// without having been counted as having left the feeder first (a part that never touched a
   /// feeder and fell off an edge).
   int parts_fell = 0;
-  /// Parts whose centre passed through a fixture (tunnelling: through a floor or a wall): within
-  /// one step, or into it and out on another side, or into it and then out of the scene. They
-  /// stay in the simulation until they leave it; each part is counted once. Parts beyond the
-  /// exit plane are not checked (they are out of the measurement).
+  /// Parts whose anchor (rule above: the centre, or a point in a hollow part's material) passed
+  /// through a fixture (tunnelling: through a floor or a wall): within one step, or into it and
+  /// out on another side, or into it and then out of the scene. They stay in the simulation
+  /// until they leave it; each part is counted once. Parts beyond the exit plane are not checked
+  /// (they are out of the measurement).
   int parts_through_fixture = 0;
   /// Parts that left the feeder without crossing the exit plane: over a wall, a rim or a side,
   /// onto a catch floor or into the air beyond the feeder's footprint (rule above). Kept in
   /// the simulation; counted once.
   int parts_left_feeder = 0;
-  /// Parts whose centre went into a fixture (a penetration deeper than half the part) and came
-  /// back out on the side it entered: not lost, but the contact did not hold them. Counted once
-  /// per part; not part of partsLost().
+  /// Parts whose anchor went into a fixture (a penetration deeper than the anchor's clearance:
+  /// half the part for its centre) and came back out on the side it entered: not lost, but the
+  /// contact did not hold them. Counted once per part; not part of partsLost().
   int parts_sunk = 0;
   /// Parts removed because they left the scene bounds (SceneLimits::bounds) sideways or up.
   int parts_out_of_bounds = 0;
-  /// Parts whose centre is inside a fixture now (went in and has not come out yet): a gauge,
+  /// Parts whose anchor is inside a fixture now (went in and has not come out yet): a gauge,
   /// not a count over the run. Part of partsLost() while they are inside (a plate stuck in a
   /// wall at the end of a run is lost; one sunk for a few steps counts only during them).
   int parts_inside_fixture = 0;
@@ -272,6 +283,24 @@ double partSpeed(const PartState& state, double radius);
 /// geometry and are checked by the simulation itself.
 PartCheck checkPartState(const PartState& state, const SceneLimits& limits, double radius);
 
+/// The point of a part that the tunnelling checks follow (RunHealth: through a fixture, sunk,
+/// inside a fixture) and how far it stays from the part's surface.
+struct PartAnchor {
+  Vec3 point;            ///< body frame, from the centre of mass (m)
+  double clearance = 0;  ///< the least distance from `point` to the part's surface (m)
+};
+/// The anchor of a part of shape `shape` (body frame: a mesh part's mesh centred on its centre
+/// of mass, as drawParts gives it). Its centre of mass, with the smallest half-size as the
+/// clearance (a primitive's centre is that far from its surface; a mesh's bounding box's), when
+/// that lies inside the part: every primitive, and a mesh whose generalized winding number there
+/// is above 1/2. A mesh part whose centre of mass lies outside its own solid (a nut's, in its
+/// hole) gets a point deep inside its material instead, with its distance to the nearest
+/// triangle as the clearance: of the midpoints between consecutive crossings of rays from the
+/// centre along 26 directions (a cube's faces, edges and corners) that lie inside, the farthest
+/// from the surface. A part colliding as its convex hull (Shape::collision_mesh_data) is judged
+/// by its hull. Derivation in simulation.cpp ("Tunnelling").
+PartAnchor partAnchor(const Shape& shape);
+
 /// Where a simulation's steps spend their time, summed over the steps taken while stage timing
 /// was on (Simulation::setStageTiming), with the contacts of those steps. For benchmarks
 /// (demos/bench/crowd_scale_bench.cpp); off by default, when no clock is read.
@@ -310,10 +339,10 @@ class Simulation {
   /// Advance one time step of scene.solver.time_step (s), spawning the parts that are due. After
   /// the step every active part is checked (RunHealth): a part with a non-finite state, faster
   /// than the scene's speed bound, below Scene::removal_height or beyond the scene bounds is
-  /// taken out of the simulation and counted; a part whose centre crossed a fixture surface,
-  /// that left the feeder or that is faster than its physical bound is counted and kept. Nothing is
-  /// thrown for a bad state: the first part of each kind is named on stderr, the counts are in
-  /// health().
+  /// taken out of the simulation and counted; a part whose anchor (partAnchor) crossed a fixture
+  /// surface, that left the feeder or that is faster than its physical bound is counted and kept.
+  /// Nothing is thrown for a bad state: the first part of each kind is named on stderr, the counts
+  /// are in health().
   virtual void step() = 0;
   /// Simulated time (s).
   virtual double time() const = 0;

@@ -1,0 +1,124 @@
+// SPDX-License-Identifier: MIT
+// The point of a part the tunnelling checks follow (simulation.hpp, partAnchor; the rule is in
+// simulation.cpp, "Tunnelling"): the centre of mass, or for a mesh part whose centre lies outside
+// its own solid (a nut's, in its hole), a point deep in its material.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "simulation_internal.hpp"
+
+namespace rheofeed::scene {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+Vec3 meshVertex(const TriangleMesh& m, std::size_t triangle, int corner) {
+  const double* v = &m.vertices[3 * static_cast<std::size_t>(m.triangles[3 * triangle + corner])];
+  return {v[0], v[1], v[2]};
+}
+
+// Generalized winding number of a closed mesh at p: the solid angles of its triangles seen from
+// p (Van Oosterom and Strackee), summed, over 4 pi. 1 inside an outward mesh, 0 outside.
+double windingNumber(const TriangleMesh& m, const Vec3& p) {
+  double sum = 0;
+  for (std::size_t t = 0; 3 * t + 2 < m.triangles.size(); ++t) {
+    const Vec3 a = meshVertex(m, t, 0) - p, b = meshVertex(m, t, 1) - p,
+               c = meshVertex(m, t, 2) - p;
+    const double la = norm(a), lb = norm(b), lc = norm(c);
+    sum += 2 * std::atan2(dot(a, cross(b, c)),
+                          la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb);
+  }
+  return sum / (4 * kPi);
+}
+
+// Distance from p to the triangle (a, b, c): its closest point by the triangle's Voronoi
+// regions (Ericson, Real-Time Collision Detection, 5.1.5).
+double triangleDistance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return norm(ap);
+  const Vec3 bp = p - b;
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return norm(bp);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return norm(ap - (d1 / (d1 - d3)) * ab);
+  const Vec3 cp = p - c;
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return norm(cp);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return norm(ap - (d2 / (d2 - d6)) * ac);
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+    return norm(bp - ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b));
+  }
+  const double denom = 1 / (va + vb + vc);
+  return norm(ap - (vb * denom) * ab - (vc * denom) * ac);
+}
+
+double meshDistance(const TriangleMesh& m, const Vec3& p) {
+  double best = kInf;
+  for (std::size_t t = 0; 3 * t + 2 < m.triangles.size(); ++t) {
+    best = std::min(
+        best, triangleDistance(p, meshVertex(m, t, 0), meshVertex(m, t, 1), meshVertex(m, t, 2)));
+  }
+  return best;
+}
+
+// Distances t > 0 at which the ray o + t d meets the mesh's triangles (Moller-Trumbore, either
+// side), sorted.
+std::vector<double> rayCrossings(const TriangleMesh& m, const Vec3& o, const Vec3& d) {
+  std::vector<double> hits;
+  for (std::size_t t = 0; 3 * t + 2 < m.triangles.size(); ++t) {
+    const Vec3 a = meshVertex(m, t, 0), e1 = meshVertex(m, t, 1) - a, e2 = meshVertex(m, t, 2) - a;
+    const Vec3 q = cross(d, e2);
+    const double det = dot(e1, q);
+    if (det == 0) continue;  // parallel to the triangle's plane
+    const Vec3 s = o - a;
+    const double u = dot(s, q) / det;
+    if (u < 0 || u > 1) continue;
+    const Vec3 r = cross(s, e1);
+    const double v = dot(d, r) / det;
+    if (v < 0 || u + v > 1) continue;
+    const double dist = dot(e2, r) / det;
+    if (dist > 0) hits.push_back(dist);
+  }
+  std::sort(hits.begin(), hits.end());
+  return hits;
+}
+
+}  // namespace
+
+PartAnchor partAnchor(const Shape& shape) {
+  PartAnchor anchor;
+  double radius = 0;
+  partSizes(shape, anchor.clearance, radius);
+  const std::shared_ptr<const TriangleMesh>& mesh =
+      shape.collision_mesh_data ? shape.collision_mesh_data : shape.mesh_data;
+  if (shape.kind != Shape::Kind::Mesh || !mesh || windingNumber(*mesh, {}) > 0.5) return anchor;
+  // Spans between consecutive crossings closer than this (m) are one crossing counted twice (a
+  // ray through an edge or a vertex shared by several triangles).
+  const double same = 1e-9 * radius;
+  double deepest = 0;
+  for (int k = 0; k < 27; ++k) {
+    const Vec3 dir{k % 3 - 1.0, (k / 3) % 3 - 1.0, k / 9 - 1.0};
+    if (k == 13) continue;  // (0, 0, 0)
+    const Vec3 d = (1 / norm(dir)) * dir;
+    const std::vector<double> hits = rayCrossings(*mesh, {}, d);
+    for (std::size_t j = 1; j < hits.size(); ++j) {
+      if (hits[j] - hits[j - 1] <= same) continue;
+      const Vec3 x = (0.5 * (hits[j - 1] + hits[j])) * d;
+      if (!(windingNumber(*mesh, x) > 0.5)) continue;
+      const double depth = meshDistance(*mesh, x);
+      if (depth > deepest) {
+        deepest = depth;
+        anchor = {x, depth};
+      }
+    }
+  }
+  return anchor;
+}
+
+}  // namespace rheofeed::scene
