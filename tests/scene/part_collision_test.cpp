@@ -132,6 +132,53 @@ TEST(PartAnchor, NutWithItsCentreInTheHoleIsFollowedByAPointDeepInItsRing) {
   EXPECT_LE(a.clearance, deepest + kGeometryTolerance);
 }
 
+// A flat ring (washer) of radii 4 and 8 mm, 1 mm thick, 24 sectors, its axis along the unit
+// vector `axis` of its own frame (a part tilted in its CAD file), centred on the origin.
+TriangleMesh tiltedRing(const Vec3& axis) {
+  constexpr int kSectors = 24;
+  constexpr double kInner = 0.004, kOuter = 0.008, kHalf = 0.0005;
+  // An orthonormal frame (e1, e2, axis).
+  const Vec3 e1 = (1 / norm(cross(axis, {1, 0, 0}))) * cross(axis, {1, 0, 0}), e2 = cross(axis, e1);
+  TriangleMesh m;
+  m.source = "tilted ring";
+  // Cross-section corners counter-clockwise in the (r, z) half-plane.
+  const double section[4][2] = {
+      {kInner, -kHalf}, {kOuter, -kHalf}, {kOuter, kHalf}, {kInner, kHalf}};
+  for (int k = 0; k < kSectors; ++k) {
+    const double a = 2 * kPi * k / kSectors;
+    for (const auto& [r, z] : section) {
+      const Vec3 v = (r * std::cos(a)) * e1 + (r * std::sin(a)) * e2 + z * axis;
+      m.vertices.insert(m.vertices.end(), {v.x, v.y, v.z});
+    }
+  }
+  auto at = [](int k, int j) { return 4 * (k % kSectors) + j % 4; };
+  for (int k = 0; k < kSectors; ++k) {
+    for (int j = 0; j < 4; ++j) {  // outward: (around) x (across the section)
+      m.triangles.insert(m.triangles.end(), {at(k, j), at(k + 1, j), at(k + 1, j + 1)});
+      m.triangles.insert(m.triangles.end(), {at(k, j), at(k + 1, j + 1), at(k, j + 1)});
+    }
+  }
+  return m;
+}
+
+// A washer whose axis is tilted in its file: none of the 26 cube directions from its centre
+// (in its hole) crosses its 1 mm thick material. The anchor must still lie in the material, at
+// most half its thickness deep, and not far less.
+TEST(PartAnchor, WasherTiltedInItsFileIsFollowedByAPointInItsMaterial) {
+  const Vec3 axis = (1 / norm(Vec3{0.17, 0.42, 0.89})) * Vec3{0.17, 0.42, 0.89};
+  Shape ring;
+  ring.kind = Shape::Kind::Mesh;
+  ring.mesh_data = std::make_shared<const TriangleMesh>(tiltedRing(axis));
+  ASSERT_GT(massProperties(*ring.mesh_data, 1.0).volume, 0);  // closed and outward
+  const PartAnchor a = partAnchor(ring);
+  const double along = dot(a.point, axis), across = norm(a.point - along * axis);
+  EXPECT_LT(std::abs(along), 0.0005);
+  EXPECT_GT(across, 0.004);
+  EXPECT_LT(across, 0.008 * std::cos(kPi / 24));  // inside the 24-gon's flat sides
+  EXPECT_LE(a.clearance, 0.0005 + kGeometryTolerance);
+  EXPECT_GE(a.clearance, 0.00025);
+}
+
 TEST(PartAnchor, SolidPartsAreFollowedByTheirCentreAtTheirSmallestHalfSize) {
   Shape box;
   box.kind = Shape::Kind::Box;

@@ -87,10 +87,34 @@ TriangleMesh loadTriangleMesh(const fs::path& file, double scale) {
   }
 
   Assimp::Importer importer;
-  const aiScene* ai =
-      importer.ReadFile(file.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                           aiProcess_PreTransformVertices | aiProcess_SortByPType |
-                                           aiProcess_ValidateDataStructure);
+  const aiScene* ai = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure);
+  if (ai == nullptr) {
+    throw std::runtime_error(
+        name + ": cannot read it (corrupt or unknown format): " + importer.GetErrorString());
+  }
+  // Non-finite coordinates are refused before the vertices are joined: joining compares
+  // coordinates, and a NaN one could be merged into a finite vertex and vanish. Named by the
+  // face that uses the vertex, in the file's order of faces.
+  for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
+    const aiMesh* part = ai->mMeshes[m];
+    for (unsigned f = 0; f < part->mNumFaces; ++f) {
+      for (unsigned k = 0; k < part->mFaces[f].mNumIndices; ++k) {
+        const aiVector3D& p = part->mVertices[part->mFaces[f].mIndices[k]];
+        const double xyz[3] = {p.x, p.y, p.z};
+        for (int c = 0; c < 3; ++c) {
+          if (!std::isfinite(xyz[c])) {
+            throw std::invalid_argument(
+                name + ": face " + std::to_string(f + 1) + " of mesh " + std::to_string(m + 1) +
+                " in the file has a vertex with a non-finite coordinate (" +
+                std::string(1, "xyz"[c]) + " = " + formatNumber(xyz[c]) + ")");
+          }
+        }
+      }
+    }
+  }
+  ai = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                    aiProcess_PreTransformVertices | aiProcess_SortByPType |
+                                    aiProcess_ValidateDataStructure);
   if (ai == nullptr) {
     throw std::runtime_error(
         name + ": cannot read it (corrupt or unknown format): " + importer.GetErrorString());

@@ -101,10 +101,24 @@ PartAnchor partAnchor(const Shape& shape) {
   // Spans between consecutive crossings closer than this (m) are one crossing counted twice (a
   // ray through an edge or a vertex shared by several triangles).
   const double same = 1e-9 * radius;
-  double deepest = 0;
+  // Directions: a cube's 26 (faces, edges, corners), and towards the centroids of up to
+  // kMaxCentroidRays of the mesh's triangles, spread through it: a ray towards a triangle meets
+  // it, so a thin part in any orientation in its file (a ring tilted in its CAD frame, which the
+  // 26 alone can all miss) gets candidates.
+  constexpr std::size_t kMaxCentroidRays = 256;
+  std::vector<Vec3> directions;
   for (int k = 0; k < 27; ++k) {
-    const Vec3 dir{k % 3 - 1.0, (k / 3) % 3 - 1.0, k / 9 - 1.0};
-    if (k == 13) continue;  // (0, 0, 0)
+    if (k != 13) directions.push_back({k % 3 - 1.0, (k / 3) % 3 - 1.0, k / 9 - 1.0});  // not 0
+  }
+  const std::size_t triangles = mesh->triangles.size() / 3;
+  const std::size_t stride = std::max<std::size_t>(1, triangles / kMaxCentroidRays);
+  for (std::size_t t = 0; t < triangles; t += stride) {
+    const Vec3 c =
+        (1.0 / 3) * (meshVertex(*mesh, t, 0) + meshVertex(*mesh, t, 1) + meshVertex(*mesh, t, 2));
+    if (norm(c) > same) directions.push_back(c);
+  }
+  double deepest = 0;
+  for (const Vec3& dir : directions) {
     const Vec3 d = (1 / norm(dir)) * dir;
     const std::vector<double> hits = rayCrossings(*mesh, {}, d);
     for (std::size_t j = 1; j < hits.size(); ++j) {

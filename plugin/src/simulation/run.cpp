@@ -97,8 +97,8 @@ std::string healthSummary(const RunHealth& h, int parts) {
   }
   if (h.parts_sunk > 0) {
     s << separator << h.parts_sunk << (h.parts_sunk == 1 ? " part" : " parts")
-      << " sank into a fixture by more than half their size "
-      << "and came back";
+      << " sank into a fixture (deeper than half their size, or a hollow part deeper than the "
+      << "point it is followed by lies in its material) and came back";
     separator = "; ";
   }
   if (h.coulomb_fallback_steps > 0) {

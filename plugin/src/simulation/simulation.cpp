@@ -65,7 +65,8 @@
 // is inside when the mesh's generalized winding number there is above 1/2 (the solid angle the
 // triangles subtend, summed, over 4 pi: 1 inside a closed outward mesh, 0 outside, whatever
 // the mesh's edges and vertices); otherwise rays from the origin along the 26 directions of a
-// cube's faces, edges and corners are cut by the mesh, the midpoints of the spans between
+// cube's faces, edges and corners and towards up to 256 triangle centroids (so that a thin part
+// tilted in its file is met) are cut by the mesh, the midpoints of the spans between
 // consecutive crossings that are inside (winding number) are the candidates, and the one
 // farthest from the nearest triangle is the anchor. The M6 nut's is midway between its hole
 // and an outer corner, about 1.2 mm deep (2.5 mm is its smallest half-size).
@@ -426,12 +427,24 @@ void PartSimulation::spawnDue() {
     const PartInstance& p = instances_[next_++];
     addPart(p);
     Track tr;
-    double min_half = 0;  // partAnchor's clearance for a centre of mass
-    partSizes(p.shape, min_half, tr.radius);
-    const PartAnchor anchor = partAnchor(p.shape);
-    tr.anchor = anchor.point;
-    tr.off_centre = anchor.point != Vec3{};
-    tr.clearance = anchor.clearance;
+    partSizes(p.shape, tr.clearance, tr.radius);  // the clearance of a centre of mass
+    if (p.shape.kind == Shape::Kind::Mesh) {
+      // The anchor of the family's mesh at scale 1, found once, scaled to this part.
+      auto found = unit_anchors_.find(p.spec);
+      if (found == unit_anchors_.end()) {
+        const PartSpec& spec = scene_.parts.at(static_cast<std::size_t>(p.spec));
+        Shape unit;
+        unit.kind = Shape::Kind::Mesh;
+        unit.mesh_data = spec.mesh_data;
+        unit.collision_mesh_data = spec.collision_mesh_data;
+        found = unit_anchors_.emplace(p.spec, partAnchor(unit)).first;
+      }
+      tr.off_centre = found->second.point != Vec3{};
+      if (tr.off_centre) {
+        tr.anchor = p.shape.mesh_scale * found->second.point;
+        tr.clearance = p.shape.mesh_scale * found->second.clearance;
+      }
+    }
     tr.last = partState(static_cast<int>(tracks_.size()));
     tr.beyond_exit = beyondExitPlane(scene_.outputs, tr.last.position);
     tracks_.push_back(tr);
@@ -587,7 +600,8 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const Vec3&
            << (tr.off_centre ? "'s anchor (a point inside its material: its centre of mass lies "
                                "outside it) "
                              : "'s centre ")
-           << what << " at t = " << time_ << " s, x = " << formatPosition(to);
+           << what << " at t = " << time_ << " s, "
+           << (tr.off_centre ? "the anchor at x = " : "x = ") << formatPosition(to);
       reportFirst("part sunk into a fixture", line.str());
     }
     return;

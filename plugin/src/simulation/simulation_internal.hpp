@@ -155,6 +155,7 @@ class PartSimulation : public Simulation {
 
   const Method method_;
   const std::vector<PartInstance> instances_;
+  std::unordered_map<int, PartAnchor> unit_anchors_;  // by part family: partAnchor at scale 1
   // The distinct drift tables of the local-law feeders (feeders and runs may share one) and their
   // counts when this run took them: the run reports the difference.
   std::vector<std::pair<std::shared_ptr<LocalDriftTable>, LocalDriftStats>> local_tables_;

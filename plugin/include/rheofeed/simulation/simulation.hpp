@@ -296,9 +296,12 @@ struct PartAnchor {
 /// is above 1/2. A mesh part whose centre of mass lies outside its own solid (a nut's, in its
 /// hole) gets a point deep inside its material instead, with its distance to the nearest
 /// triangle as the clearance: of the midpoints between consecutive crossings of rays from the
-/// centre along 26 directions (a cube's faces, edges and corners) that lie inside, the farthest
-/// from the surface. A part colliding as its convex hull (Shape::collision_mesh_data) is judged
-/// by its hull. Derivation in simulation.cpp ("Tunnelling").
+/// centre along 26 directions (a cube's faces, edges and corners) and towards the centroids of
+/// up to 256 of its triangles that lie inside, the farthest from the surface (a ray towards a
+/// triangle meets it, so any closed mesh gets one, in any orientation in its file; should none
+/// be found, the centre is kept). A part colliding as its convex hull
+/// (Shape::collision_mesh_data) is judged by its hull. Runs compute it once per part family at
+/// scale 1 and scale it. Derivation in simulation.cpp ("Tunnelling").
 PartAnchor partAnchor(const Shape& shape);
 
 /// Where a simulation's steps spend their time, summed over the steps taken while stage timing
