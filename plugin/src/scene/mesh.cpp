@@ -204,8 +204,9 @@ MassProperties massProperties(const TriangleMesh& mesh, double density) {
   const double volume = six_volume / 6;
   if (!(volume > 0)) {
     throw std::invalid_argument(name + ": signed volume " + formatNumber(volume) +
-                                " (the mesh's length unit cubed) <= 0: the mesh is open or inside "
-                                "out (triangles must be counter-clockwise seen from outside)");
+                                " (the mesh's length unit cubed) <= 0: the mesh encloses no volume "
+                                "(flat, or two-sided), or is inside out (triangles must be "
+                                "counter-clockwise seen from outside)");
   }
   // A flat or sliver solid: its volume against the sphere about r0 through the farthest vertex.
   double r2 = 0;
