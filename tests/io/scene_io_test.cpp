@@ -363,6 +363,32 @@ TEST(SceneFile, ConvexHullPartsCollideWithTheHullScaledAsTheirMesh) {
   }
 }
 
+// Built in code: the hull is chosen by the part's setting, never by leftover data; a hull not
+// built, or asked of a primitive part, is an error naming the part.
+TEST(SceneFile, ConvexHullFollowsTheSettingAndIsRefusedWhereItCannotApply) {
+  Scene hull = parseScene(toJson(everyFieldScene()), "x.json", CountingLoader{}.loader());
+  Scene mesh = hull;
+  mesh.parts[3].collision = PartSpec::Collision::Mesh;  // the hull data is still there
+  for (const PartInstance& p : drawParts(mesh)) EXPECT_FALSE(p.shape.collision_mesh_data);
+  Scene unbuilt = hull;
+  unbuilt.parts[3].collision_mesh_data = nullptr;
+  try {
+    drawParts(unbuilt);
+    ADD_FAILURE() << "drawn without its hull";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("parts[3].collision"), std::string::npos) << e.what();
+  }
+  Scene box = hull;
+  box.parts[0].collision = PartSpec::Collision::ConvexHull;
+  try {
+    box.validate();
+    ADD_FAILURE() << "a box part accepted as a convex hull";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("parts[0].collision: only mesh parts"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(SceneFile, SceneWithoutMeshesNeverCallsTheMeshLoader) {
   Scene s = everyFieldScene();
   s.fixtures.erase(s.fixtures.begin() + 2);  // the bowl

@@ -288,15 +288,6 @@ TriangleMesh convexHull(const TriangleMesh& mesh) {
     }
   }
   std::vector<coordT> points(mesh.vertices.begin(), mesh.vertices.end());
-  // qhull's messages go to a memory stream, quoted in the exception; nothing reaches stderr.
-  char* message = nullptr;
-  std::size_t message_size = 0;
-  FILE* err = open_memstream(&message, &message_size);
-  if (!err) throw std::runtime_error(name + ": convex hull: cannot open a message stream");
-  qhT qh_storage;
-  qhT* qh = &qh_storage;
-  QHULL_LIB_CHECK
-  qh_zero(qh, err);
   // Facets within a millionth of the mesh's size of coplanar are merged ('C-n'): a flat face
   // is one polygon even where the file rounded the points along its edges (an OBJ's 6 decimals).
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
@@ -307,28 +298,63 @@ TriangleMesh convexHull(const TriangleMesh& mesh) {
   char command[64];
   std::snprintf(command, sizeof command, "qhull C-%.3g",
                 1e-6 * std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
+
+  // qhull's state and its message stream (quoted in the exception; nothing reaches stderr),
+  // released on every path, exceptions included.
+  struct Qhull {
+    qhT qh;
+    char* message = nullptr;
+    std::size_t message_size = 0;
+    FILE* err = nullptr;
+    bool built = false;
+    Qhull() : err(open_memstream(&message, &message_size)) {}
+    Qhull(const Qhull&) = delete;
+    Qhull& operator=(const Qhull&) = delete;
+    ~Qhull() {
+      if (built) {
+        int still_long = 0, still_total = 0;
+        qh_freeqhull(&qh, !qh_ALL);
+        qh_memfreeshort(&qh, &still_long, &still_total);
+      }
+      if (err) std::fclose(err);
+      std::free(message);
+    }
+    std::string text() {
+      if (err) std::fflush(err);
+      return std::string(message ? message : "", message ? message_size : 0);
+    }
+  } run;
+  if (!run.err) throw std::runtime_error(name + ": convex hull: cannot open a message stream");
+  qhT* qh = &run.qh;
+  QHULL_LIB_CHECK
+  qh_zero(qh, run.err);
+  run.built = true;
   const int exit_code = qh_new_qhull(qh, 3, static_cast<int>(points.size() / 3), points.data(),
-                                     False, command, nullptr, err);
+                                     False, command, nullptr, run.err);
   TriangleMesh hull;
   hull.source = "convex hull of " + (mesh.source.empty() ? std::string("a mesh") : mesh.source);
   if (exit_code == 0) {
+    const int count = static_cast<int>(points.size() / 3);
     std::vector<int> index(points.size() / 3, -1);  // qhull point id -> hull vertex
-    auto vertexOf = [&](const vertexT* v) {
-      const int id = qh_pointid(qh, v->point);
-      if (index[static_cast<std::size_t>(id)] < 0) {
-        index[static_cast<std::size_t>(id)] = static_cast<int>(hull.vertices.size() / 3);
-        hull.vertices.insert(hull.vertices.end(), v->point, v->point + 3);
-      }
-      return index[static_cast<std::size_t>(id)];
-    };
     auto at = [&hull](int k) { return vertex(hull, k); };
     facetT* facet;
     FORALLfacets {
-      // The facet's vertices in order round it; fanned into triangles turned to face outwards.
+      // The facet's vertices in order round it (qh_facet3vertex: its only qhull call that could
+      // raise an error, on an inconsistent hull, after which qhull ends the process), fanned
+      // into triangles turned to face along its outward normal.
       setT* ring = qh_facet3vertex(qh, facet);
       std::vector<int> polygon;
       vertexT *vertex, **vertexp;
-      FOREACHvertex_(ring) polygon.push_back(vertexOf(vertex));
+      FOREACHvertex_(ring) {
+        const int id = qh_pointid(qh, vertex->point);
+        if (id < 0 || id >= count) continue;  // not an input point (qhull adds none here)
+        int& k = index[static_cast<std::size_t>(id)];
+        if (k < 0) {
+          k = static_cast<int>(hull.vertices.size() / 3);
+          hull.vertices.insert(hull.vertices.end(), vertex->point, vertex->point + 3);
+        }
+        polygon.push_back(k);
+      }
       qh_settempfree(qh, &ring);
       if (polygon.size() < 3) continue;
       const Vec3 n{facet->normal[0], facet->normal[1], facet->normal[2]};
@@ -340,13 +366,8 @@ TriangleMesh convexHull(const TriangleMesh& mesh) {
       }
     }
   }
-  int still_long = 0, still_total = 0;
-  qh_freeqhull(qh, !qh_ALL);
-  qh_memfreeshort(qh, &still_long, &still_total);
-  std::fclose(err);
-  std::string text(message ? message : "", message_size);
-  std::free(message);
   if (exit_code != 0 || hull.triangles.empty()) {
+    const std::string text = run.text();
     const std::size_t end = text.find('\n', text.find_first_not_of(" \n"));
     throw std::invalid_argument(name + ": no convex hull (the vertices span no volume?): qhull: " +
                                 text.substr(0, std::min(end, std::size_t{300})));

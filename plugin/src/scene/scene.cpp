@@ -427,6 +427,11 @@ void Scene::validate() const {
       throw std::invalid_argument(path + ".shape: a part cannot be a plane");
     if (p.shape == Shape::Kind::Mesh && p.mesh.empty())
       throw std::invalid_argument(path + ".mesh: empty file name");
+    if (p.shape != Shape::Kind::Mesh && p.collision != PartSpec::Collision::Mesh) {
+      throw std::invalid_argument(path + ".collision: only mesh parts collide as their convex "
+                                         "hull (a " + toString(p.shape) +
+                                  " part collides as itself)");
+    }
     for (int d = 0; d < dims; ++d) {
       validateDistribution(path + ".size[" + std::to_string(d) + "]", p.size[d],
                            p.shape == Shape::Kind::Mesh);
@@ -604,6 +609,11 @@ std::vector<PartInstance> drawParts(const Scene& scene) {
         throw std::invalid_argument("parts[" + std::to_string(s) + "].mesh: '" + spec.mesh +
                                     "' is not loaded (use loadScene or loadSceneMeshes)");
       }
+      if (spec.collision == PartSpec::Collision::ConvexHull && !spec.collision_mesh_data) {
+        throw std::invalid_argument("parts[" + std::to_string(s) +
+                                    "].collision: the convex hull of '" + spec.mesh +
+                                    "' is not built (use loadScene or loadSceneMeshes)");
+      }
       unit_mesh = massProperties(*spec.mesh_data, spec.density);
       unit_radius = boundingRadius(*spec.mesh_data);
       const double extent = spec.size[0].mean * unit_radius;
@@ -652,7 +662,7 @@ std::vector<PartInstance> drawParts(const Scene& scene) {
           p.shape.mesh = spec.mesh;
           p.shape.mesh_scale = scale;
           p.shape.mesh_data = mesh;
-          if (spec.collision_mesh_data) {
+          if (spec.collision == PartSpec::Collision::ConvexHull) {
             std::shared_ptr<const TriangleMesh>& hull = scaled_hulls[scale];
             if (!hull) {
               hull =

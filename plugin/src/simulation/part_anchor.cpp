@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
-// The point of a part the tunnelling checks follow (simulation.hpp, partAnchor; the rule is in
-// simulation.cpp, "Tunnelling"): the centre of mass, or for a mesh part whose centre lies outside
-// its own solid (a nut's, in its hole), a point deep in its material.
+// A part's sizes (partSizes) and the point of it the tunnelling checks follow (simulation.hpp,
+// partAnchor; the rule is in simulation.cpp, "Tunnelling"): the centre of mass, or for a mesh part
+// whose centre lies outside its own solid (a nut's, in its hole), a point deep in its material.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -91,6 +91,45 @@ std::vector<double> rayCrossings(const TriangleMesh& m, const Vec3& o, const Vec
 
 }  // namespace
 
+void partSizes(const Shape& s, double& min_half, double& radius) {
+  switch (s.kind) {
+    case Shape::Kind::Box:
+      min_half = 0.5 * std::min({s.size.x, s.size.y, s.size.z});
+      radius = 0.5 * norm(s.size);
+      return;
+    case Shape::Kind::Sphere:
+      min_half = radius = s.radius;
+      return;
+    case Shape::Kind::Cylinder:
+      min_half = std::min(s.radius, 0.5 * s.length);
+      radius = std::hypot(s.radius, 0.5 * s.length);
+      return;
+    case Shape::Kind::Capsule:
+      min_half = s.radius;
+      radius = s.radius + 0.5 * s.length;
+      return;
+    case Shape::Kind::Mesh: {
+      double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+      radius = 0;
+      min_half = 0;
+      if (!s.mesh_data || s.mesh_data->vertices.size() < 3) return;
+      for (std::size_t k = 0; k + 2 < s.mesh_data->vertices.size(); k += 3) {
+        const double* v = &s.mesh_data->vertices[k];
+        for (int c = 0; c < 3; ++c) {
+          lo[c] = std::min(lo[c], v[c]);
+          hi[c] = std::max(hi[c], v[c]);
+        }
+        radius = std::max(radius, norm(Vec3{v[0], v[1], v[2]}));
+      }
+      min_half = 0.5 * std::min({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+      return;
+    }
+    case Shape::Kind::Plane:
+      break;
+  }
+  min_half = radius = 0;
+}
+
 PartAnchor partAnchor(const Shape& shape) {
   PartAnchor anchor;
   double radius = 0;
@@ -111,7 +150,8 @@ PartAnchor partAnchor(const Shape& shape) {
     if (k != 13) directions.push_back({k % 3 - 1.0, (k / 3) % 3 - 1.0, k / 9 - 1.0});  // not 0
   }
   const std::size_t triangles = mesh->triangles.size() / 3;
-  const std::size_t stride = std::max<std::size_t>(1, triangles / kMaxCentroidRays);
+  const std::size_t stride =
+      std::max<std::size_t>(1, (triangles + kMaxCentroidRays - 1) / kMaxCentroidRays);
   for (std::size_t t = 0; t < triangles; t += stride) {
     const Vec3 c =
         (1.0 / 3) * (meshVertex(*mesh, t, 0) + meshVertex(*mesh, t, 1) + meshVertex(*mesh, t, 2));

@@ -198,43 +198,6 @@ double surfaceSpeed(const FeederLaw& law, const Bounds& b) {
 
 }  // namespace
 
-void partSizes(const Shape& s, double& min_half, double& radius) {
-  switch (s.kind) {
-    case Shape::Kind::Box:
-      min_half = 0.5 * std::min({s.size.x, s.size.y, s.size.z});
-      radius = 0.5 * norm(s.size);
-      return;
-    case Shape::Kind::Sphere:
-      min_half = radius = s.radius;
-      return;
-    case Shape::Kind::Cylinder:
-      min_half = std::min(s.radius, 0.5 * s.length);
-      radius = std::hypot(s.radius, 0.5 * s.length);
-      return;
-    case Shape::Kind::Capsule:
-      min_half = s.radius;
-      radius = s.radius + 0.5 * s.length;
-      return;
-    case Shape::Kind::Mesh: {
-      Bounds b = emptyBounds();
-      radius = 0;
-      if (s.mesh_data) {
-        for (std::size_t k = 0; k + 2 < s.mesh_data->vertices.size(); k += 3) {
-          const double* v = &s.mesh_data->vertices[k];
-          grow(b, Vec3{v[0], v[1], v[2]});
-          radius = std::max(radius, norm(Vec3{v[0], v[1], v[2]}));
-        }
-      }
-      const Vec3 e = b.max - b.min;
-      min_half = isEmpty(b) ? 0 : 0.5 * std::min({e.x, e.y, e.z});
-      return;
-    }
-    case Shape::Kind::Plane:
-      break;
-  }
-  min_half = radius = 0;
-}
-
 std::string formatPosition(const Vec3& x) {
   char b[96];
   std::snprintf(b, sizeof b, "(%.6g, %.6g, %.6g) m", x.x, x.y, x.z);
