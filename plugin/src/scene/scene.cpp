@@ -428,9 +428,10 @@ void Scene::validate() const {
     if (p.shape == Shape::Kind::Mesh && p.mesh.empty())
       throw std::invalid_argument(path + ".mesh: empty file name");
     if (p.shape != Shape::Kind::Mesh && p.collision != PartSpec::Collision::Mesh) {
-      throw std::invalid_argument(path + ".collision: only mesh parts collide as their convex "
-                                         "hull (a " + toString(p.shape) +
-                                  " part collides as itself)");
+      throw std::invalid_argument(path +
+                                  ".collision: only mesh parts collide as their convex "
+                                  "hull (a " +
+                                  toString(p.shape) + " part collides as itself)");
     }
     for (int d = 0; d < dims; ++d) {
       validateDistribution(path + ".size[" + std::to_string(d) + "]", p.size[d],

@@ -93,10 +93,9 @@ void loadSceneMeshes(Scene& scene, const fs::path& base_dir, const MeshLoader& m
     try {  // a part must be a closed, outward-oriented solid; centre it on its centre of mass
       const MassProperties mp = massProperties(*mesh, 1.0);
       p.mesh_data = std::make_shared<const TriangleMesh>(translateMesh(*mesh, -mp.centre_of_mass));
-      p.collision_mesh_data =
-          p.collision == PartSpec::Collision::ConvexHull
-              ? std::make_shared<const TriangleMesh>(convexHull(*p.mesh_data))
-              : nullptr;
+      p.collision_mesh_data = p.collision == PartSpec::Collision::ConvexHull
+                                  ? std::make_shared<const TriangleMesh>(convexHull(*p.mesh_data))
+                                  : nullptr;
     } catch (const std::exception& e) {
       fail(path, e.what());
     }

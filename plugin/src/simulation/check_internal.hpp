@@ -5,6 +5,7 @@
 // thickness in check_mesh.cpp.
 #pragma once
 
+#include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
@@ -22,6 +23,24 @@ constexpr double kSigmas = 5;
 constexpr double kSeamTolerance = 1e-6;
 // A box edge counts as upright when its direction is within this of the up direction (cosine).
 constexpr double kUprightCosine = 1 - 1e-9;
+
+// Moller-Trumbore: the distance t along the ray origin + t dir (dir need not be unit; t in its
+// lengths) at which it meets the triangle (p, q, r), either side; -1 when it misses or runs
+// parallel to the triangle's plane. Shared by the mesh wall thickness (check_mesh.cpp) and the
+// anchor search (part_anchor.cpp).
+inline double rayTriangleDistance(const Vec3& origin, const Vec3& dir, const Vec3& p, const Vec3& q,
+                                  const Vec3& r) {
+  const Vec3 e1 = q - p, e2 = r - p, pv = cross(dir, e2);
+  const double det = dot(e1, pv);
+  if (std::abs(det) < 1e-30) return -1;
+  const Vec3 tv = origin - p;
+  const double u = dot(tv, pv) / det;
+  if (u < 0 || u > 1) return -1;
+  const Vec3 qv = cross(tv, e1);
+  const double w = dot(dir, qv) / det;
+  if (w < 0 || u + w > 1) return -1;
+  return dot(e2, qv) / det;
+}
 
 // Numbers and JSON paths as the messages write them: "%.3g", "12.3 mm", "parts[2]",
 // "fixtures[0].geoms[1]".

@@ -77,20 +77,8 @@ class TriangleTree {
   }
 
  private:
-  // Moller-Trumbore ray/triangle intersection: the distance along d, or -1 for no hit (the
-  // arithmetic of the all-pairs test).
   double hit(const Vec3& origin, const Vec3& dir, std::size_t j) const {
-    const Vec3 &p = a_[j], &q = b_[j], &r = c_[j];
-    const Vec3 e1 = q - p, e2 = r - p, pv = cross(dir, e2);
-    const double det = dot(e1, pv);
-    if (std::abs(det) < 1e-30) return -1;
-    const Vec3 tv = origin - p;
-    const double u = dot(tv, pv) / det;
-    if (u < 0 || u > 1) return -1;
-    const Vec3 qv = cross(tv, e1);
-    const double w = dot(dir, qv) / det;
-    if (w < 0 || u + w > 1) return -1;
-    return dot(e2, qv) / det;
+    return checks::rayTriangleDistance(origin, dir, a_[j], b_[j], c_[j]);
   }
 
   // Whether the ray enters the node's box at a distance <= best (and >= 0 at its far side).

@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "check_internal.hpp"
 #include "simulation_internal.hpp"
 
 namespace rheofeed::scene {
@@ -67,22 +68,12 @@ double meshDistance(const TriangleMesh& m, const Vec3& p) {
   return best;
 }
 
-// Distances t > 0 at which the ray o + t d meets the mesh's triangles (Moller-Trumbore, either
-// side), sorted.
+// Distances t > 0 at which the ray o + t d meets the mesh's triangles (either side), sorted.
 std::vector<double> rayCrossings(const TriangleMesh& m, const Vec3& o, const Vec3& d) {
   std::vector<double> hits;
   for (std::size_t t = 0; 3 * t + 2 < m.triangles.size(); ++t) {
-    const Vec3 a = meshVertex(m, t, 0), e1 = meshVertex(m, t, 1) - a, e2 = meshVertex(m, t, 2) - a;
-    const Vec3 q = cross(d, e2);
-    const double det = dot(e1, q);
-    if (det == 0) continue;  // parallel to the triangle's plane
-    const Vec3 s = o - a;
-    const double u = dot(s, q) / det;
-    if (u < 0 || u > 1) continue;
-    const Vec3 r = cross(s, e1);
-    const double v = dot(d, r) / det;
-    if (v < 0 || u + v > 1) continue;
-    const double dist = dot(e2, r) / det;
+    const double dist = checks::rayTriangleDistance(o, d, meshVertex(m, t, 0), meshVertex(m, t, 1),
+                                                    meshVertex(m, t, 2));
     if (dist > 0) hits.push_back(dist);
   }
   std::sort(hits.begin(), hits.end());

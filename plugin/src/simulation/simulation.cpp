@@ -480,11 +480,10 @@ bool PartSimulation::insideFixture(const Vec3& x, bool* unknown) const {
 Vec3 PartSimulation::anchorAt(std::size_t i, const PartState& s) const {
   const Track& tr = tracks_[i];
   if (!tr.off_centre) return s.position;
-  const double* r = s.rotation;  // body to world, row-major
-  const Vec3& a = tr.anchor;
-  return s.position + Vec3{r[0] * a.x + r[1] * a.y + r[2] * a.z,
-                           r[3] * a.x + r[4] * a.y + r[5] * a.z,
-                           r[6] * a.x + r[7] * a.y + r[8] * a.z};
+  Pose pose;  // the part's: body to world
+  pose.position = s.position;
+  std::copy(s.rotation, s.rotation + 9, pose.rotation);
+  return pose.transform(tr.anchor);
 }
 
 void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const Vec3& to,
