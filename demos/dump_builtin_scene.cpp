@@ -145,24 +145,95 @@ void commentBowl(std::string& json, const Scene& scene, bool fill) {
                 "the simulation.");
 }
 
+// The mesh bowl with its outlet (meshBowlFeederScene, demos/common/bowl_scene.cpp): its geoms are
+// the bowl's mesh, then the wiper, the return chute, the outlet track and its two rails.
+void commentMeshBowl(std::string& json, const Scene& scene) {
+  const auto& g = scene.fixtures.at(0).geoms;
+  if (g.size() != 6 || g[0].shape.kind != rheofeed::scene::Shape::Kind::Mesh) {
+    throw std::logic_error(
+        "dump_builtin_scene: the mesh bowl's geoms are no longer its mesh and 5 tooling boxes: "
+        "update commentMeshBowl");
+  }
+  insertComment(
+      json, "{",
+      "The vibratory bowl feeder as a mesh, with tooling and an outlet (`rheofeed run "
+      "bowl_feeder_mesh_fill`; written by dump_builtin_scene from builtin_scenes.hpp "
+      "meshBowlFeederScene()). 200 M6 nuts, read from their mesh, are poured onto the bowl's "
+      "central cone at 5 parts/s (40 s); they slide to the wall, are carried round and up the "
+      "2-turn helical ramp by the bowl's screw vibration, meet a wiper on the last turn that "
+      "pushes "
+      "nuts not lying flat (on edge, or riding on another nut) back into the bowl over a return "
+      "chute, and leave lying flat through a tangential outlet. The rheonomic runs use the local "
+      "vibration law (no calibration) at h = 0.01 s. Outputs: output rate and cumulative count at "
+      "the exit plane, first part out, exit orientation, mean height against time, angular drift. "
+      "The bowl of boxes with the same tooling is bowl_feeder_fill; the 12-nut mesh bowl with its "
+      "cone of boxes and no outlet, bowl_feeder. " +
+          kDriftTableNote);
+  insertComment(
+      json, "\"name\": \"bowl\",",
+      "geoms, in order: 0 the bowl, one mesh (demos/meshes/vibratory_bowl_outlet.stl, millimetres "
+      "scaled by 0.001; generate_meshes.cpp): inner radius 150 mm, wall 5 mm thick and 100 mm "
+      "high, cut down to 64 mm over azimuth -0.5..40 degrees for the outlet; a floor falling 4 "
+      "degrees towards the wall; a central cone of revolution falling 25 degrees (> atan(mu) = "
+      "16.7, so nuts slide off) from a flat top of radius 70 mm at z = 37 mm to the floor at r = "
+      "124 "
+      "mm; the helical ramp (20 mm wide, r = 130..150 mm, 4 mm thick, pitch 30 mm, 2 turns "
+      "counter-clockwise rising from the floor at azimuth 0, its top falling 3 degrees towards the "
+      "wall); 1 the wiper across the last turn at azimuth 300 degrees, 6.5 mm above the track, 35 "
+      "degrees to it; 2 the return chute under it, falling 35 degrees inwards to the cone; 3 the "
+      "outlet track, straight along +y from the ramp's top (z = 70.5 mm on its centre line) at "
+      "azimuth 0, through the cut; 4-5 its rails. The tooling is bowl_feeder_fill's, fitted to "
+      "this ramp and cone; boxes, which ODE collides as solids.");
+  insertComment(json, "\"law\": {",
+                "Screw vibration at 50 Hz: 0.15 mm vertical (1.5 g: the nuts hop) and 0.17 "
+                "degrees torsion (0.13 m/s peak at r = 140 mm), as bowl_feeder.json. drift_model "
+                "local: the rheonomic runs use the local vibration law, no calibration.");
+  insertComment(json, "\"name\": \"m6_nuts\",",
+                "M6 nut blanks (10 mm across flats, 5 mm thick, a 6 mm hole; 2.3 g) read from "
+                "demos/meshes/hex_nut_m6.obj: size[0] is the mesh's scale, millimetres to metres "
+                "with a 3 % spread. collision convex_hull: the engines collide each nut as its "
+                "convex hull, the plain hexagonal prism (nothing in this bowl enters the hole); "
+                "mass, inertia and drawing keep the hole. Dropped one by one at `rate` from at "
+                "most 15 mm above the cone (r = 90..102 mm, azimuth about 275 degrees). "
+                "Orientation: +z or -z up is lying flat.");
+  insertComment(json, "\"solver\": {",
+                "time_step 0.2 ms: 100 steps per vibration period, for a quick full-vibration "
+                "look; the bowl's ramp drift converges only at 1000 steps per cycle or finer "
+                "(demos/results/bowl_feeder.md, section 10). rheonomic_time_step 0.01 s, the "
+                "paper's bowl step.");
+  insertComment(json, "\"outputs\": {",
+                "angular drift about +z (rad/s) after 1 s; the exit plane is tangent to r = 175 "
+                "mm at azimuth 45 degrees, outside the wall (r <= 155 mm), crossed only by nuts "
+                "on the outlet track; parts past it fall below removal_height (-0.1 m) and leave "
+                "the simulation.");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"write a built-in scene as JSON on stdout"};
   std::string name;
   app.add_option("SCENE", name,
-                 "bowl_feeder_primitives (12 nuts) or bowl_feeder_fill (240 nuts poured in)")
+                 "bowl_feeder_primitives (12 nuts), bowl_feeder_fill (240 nuts poured in) or "
+                 "bowl_feeder_mesh_fill (the mesh bowl with its outlet, 200 mesh nuts poured in)")
       ->required()
-      ->check(CLI::IsMember({"bowl_feeder_primitives", "bowl_feeder_fill"}));
+      ->check(
+          CLI::IsMember({"bowl_feeder_primitives", "bowl_feeder_fill", "bowl_feeder_mesh_fill"}));
   CLI11_PARSE(app, argc, argv);
   using namespace rheofeed::scene;
   try {
-    const bool fill = name == "bowl_feeder_fill";
-    Scene scene = fill ? bowlFeederScene(240, 6, true, 300) : bowlFeederScene();
+    const bool fill = name == "bowl_feeder_fill", mesh = name == "bowl_feeder_mesh_fill";
+    Scene scene = mesh   ? meshBowlFeederScene()
+                  : fill ? bowlFeederScene(240, 6, true, 300)
+                         : bowlFeederScene();
     // The shipped scenes' drift table (demos/scenes/tables/): a first run skips its model runs.
     scene.drift_table = kDriftTable;
     std::string json = toJson(scene);
-    commentBowl(json, scene, fill);
+    if (mesh) {
+      commentMeshBowl(json, scene);
+    } else {
+      commentBowl(json, scene, fill);
+    }
     std::cout << json;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dump_builtin_scene: %s\n", e.what());

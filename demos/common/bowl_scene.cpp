@@ -61,15 +61,38 @@ constexpr double kOutletLength = 0.125;       // straight outlet track, tangent 
 constexpr double kOutletWallTop = 0.064;      // the wall is cut down to this where it exits
 constexpr double kExitRadius = 0.175;         // the exit plane: tangent to this circle at 45 deg
 
-// The ramp starts 1 mm below the floor's top, so that it rises out of the floor (over the first
-// 12 degrees) instead of starting at a step a nut's rim can catch on.
-constexpr double kRampStart = kFloorTop - 0.001;
+// What the tooling (wiper, return chute, outlet) needs of a bowl whose ramp follows the
+// constants above (m): the ramp's top on its centre line at azimuth 0, its thickness there, the
+// line of the central cone (it meets the floor at cone_foot_radius, height cone_foot_z, and rises
+// inwards at kConeSlope), and the wall's top where the outlet leaves through it.
+struct BowlLayout {
+  double track_top_start;
+  double track_thickness;
+  double cone_foot_radius;
+  double cone_foot_z;
+  double outlet_wall_top;
 
-// Height of the ramp's top surface on its centre line at azimuth phi (rad, from +x, counted on
-// along the ramp: phi in [0, 2 pi kTurns]).
-double trackTop(double phi) {
-  return kRampStart + kPitch * phi / (2 * kPi);
-}
+  // Height of the ramp's top surface on its centre line at azimuth phi (rad, from +x, counted on
+  // along the ramp: phi in [0, 2 pi kTurns]).
+  double trackTop(double phi) const { return track_top_start + kPitch * phi / (2 * kPi); }
+  // The cone's surface at radius r (inside the foot).
+  double coneAt(double r) const {
+    return cone_foot_z + (cone_foot_radius - r) * std::tan(kConeSlope);
+  }
+};
+
+// The bowl of boxes: the ramp starts 1 mm below the floor's top, so that it rises out of the
+// floor (over the first 12 degrees) instead of starting at a step a nut's rim can catch on.
+constexpr BowlLayout kBoxBowl{kFloorTop - 0.001, kTrackThickness, kConeOuter, kFloorTop,
+                              kOutletWallTop};
+
+// The mesh bowl (demos/meshes/vibratory_bowl_outlet.stl, generate_meshes.cpp; mm there): the
+// ramp's top rises from z = 10 mm at the wall (r = 150 mm) and falls 3 degrees towards it, so on
+// the centre line it starts 10 mm x tan 3 degrees higher; 4 mm thick below the wall's edge; the
+// cone meets the 4 degree floor at r = 124 mm.
+const BowlLayout kMeshBowl{0.010 + 0.010 * std::tan(kTrackTilt),
+                           0.004 + 0.010 * std::tan(kTrackTilt), 0.124,
+                           0.010 + 0.026 * std::tan(4 * kDeg), kOutletWallTop};
 
 double trackCentre() {
   return kInnerRadius - 0.5 * kTrackWidth;
@@ -102,6 +125,123 @@ void addCone(Fixture& bowl, int count) {
   const double cap = 2 * kConeInner + 0.004;
   bowl.geoms.push_back(
       box({cap, cap, thickness}, Pose::axisAngle({0, 0, 1}, 0, {0, 0, cap_top - 0.5 * thickness})));
+}
+
+// The tooling on the last turn and the outlet of a bowl laid out as `layout`: the wiper, the
+// return chute under it, and the straight outlet track with its rails (all boxes).
+void addTooling(Fixture& bowl, const BowlLayout& layout) {
+  // Wiper: a blade across the last turn, kWiperClearance above the track, running from the
+  // wall forwards and inwards at kWiperAngle. Nuts lying flat (5 mm) pass under it; nuts on
+  // edge (9-11 mm) or riding on another nut hit it, slide along it and fall off the track's
+  // inner edge back into the bowl. Its bottom follows the track's top (which rises along the
+  // helix and falls towards the wall, a few mm over the blade's length): under a level blade a
+  // 9 mm cube slid along it and passed where its top overlapped the blade by about 1 mm. Its
+  // outer end lies in the wall: the end face (square to the blade) has one corner 1.6 mm into
+  // the wall and the other beyond its outer face.
+  const double blade_height = 0.020, blade_thickness = 0.012;
+  const double phi0 = 2 * kPi + kWiperAzimuth;
+  const double r0 = kInnerRadius + 0.001 + 0.5 * blade_thickness * std::cos(kWiperAngle),
+               r1 = kInnerRadius - kTrackWidth - 0.004;
+  const double along = (r0 - r1) / std::tan(kWiperAngle);
+  const double phi1 = phi0 + along / trackCentre();
+  // The track's top at radius r, azimuth phi (it falls outwards at kTrackTilt).
+  const auto top_at = [&layout](double r, double phi) {
+    return layout.trackTop(phi) - std::tan(kTrackTilt) * (r - trackCentre());
+  };
+  const Vec3 p0{r0 * std::cos(phi0), r0 * std::sin(phi0), top_at(r0, phi0) + kWiperClearance};
+  const Vec3 p1{r1 * std::cos(phi1), r1 * std::sin(phi1), top_at(r1, phi1) + kWiperClearance};
+  const Vec3 d = p1 - p0;  // along the blade's bottom edge
+  const double level = std::hypot(d.x, d.y);
+  const Pose yaw = Pose::axisAngle({0, 0, 1}, std::atan2(d.y, d.x));
+  const Pose pitch = Pose::axisAngle({0, 1, 0}, -std::atan2(d.z, level));
+  const Pose blade = composed(yaw, pitch, Vec3{});
+  bowl.geoms.push_back(
+      box({norm(d), blade_thickness, blade_height},
+          composed(yaw, pitch, 0.5 * (p0 + p1) + blade.rotate({0, 0, 0.5 * blade_height}))));
+
+  // Return chute: a plate under the wiper's drop zone, from just below the ramp's inner
+  // edge down inwards at 35 degrees (> atan(mu), so nuts slide) to the cone. A wiped nut
+  // falls about 10 mm onto it instead of 50 mm onto the cone's foot (1 m/s, 10 mm per step:
+  // its centre crossed the cone's surface for a step). Its top edge stays 5 mm inside the
+  // ramp's inner edge and it is 6 mm thick and 50 mm wide, so that no part of it hangs lower
+  // than 7 mm over the turn below (a 12 mm plate 70 mm wide reached down to that track's top
+  // and jammed the nuts climbing under it).
+  const double chute_slope = 35 * kDeg, chute_thickness = 0.006;
+  const double r_top = kInnerRadius - kTrackWidth - 0.005;
+  const double z_top = layout.trackTop(phi0) - layout.track_thickness - 0.003;
+  // Where the plate's top meets the cone: z_top - (r_top - r) tan(chute) = cone(r).
+  const double r_meet = (layout.coneAt(0) - z_top + r_top * std::tan(chute_slope)) /
+                        (std::tan(chute_slope) + std::tan(kConeSlope));
+  const double run = r_top - r_meet + 0.004;  // 4 mm into the cone
+  const double chute_az = phi0 + 0.5 * (phi1 - phi0) + 5 * kDeg;
+  const Vec3 inward{-std::cos(chute_az), -std::sin(chute_az), 0};
+  const Vec3 top_mid = (r_top - 0.5 * run) * Vec3{std::cos(chute_az), std::sin(chute_az), 0} +
+                       Vec3{0, 0, z_top - 0.5 * run * std::tan(chute_slope)};
+  const Vec3 up_normal = std::sin(chute_slope) * inward + Vec3{0, 0, std::cos(chute_slope)};
+  // Rz(azimuth + pi) Ry(chute): local x runs down the plate, inwards; local z is its normal.
+  bowl.geoms.push_back(box(
+      {run / std::cos(chute_slope), 0.050, chute_thickness},
+      composed(Pose::axisAngle({0, 0, 1}, chute_az + kPi), Pose::axisAngle({0, 1, 0}, chute_slope),
+               top_mid - 0.5 * chute_thickness * up_normal)));
+
+  // Outlet: a straight track leaving the ramp's top tangentially (+y at azimuth 0), through
+  // the cut-down wall, with a rail on each side.
+  const double top = layout.trackTop(2 * kPi * kTurns);
+  const Pose roll = Pose::axisAngle({0, 1, 0}, kTrackTilt);  // top falls outwards (+x)
+  const double x = trackCentre() + 0.0005;
+  bowl.geoms.push_back(box(
+      {kTrackWidth + 0.001, kOutletLength, kTrackThickness},
+      composed(roll, Pose{},
+               Vec3{x, 0.5 * kOutletLength, top} - roll.rotate({0, 0, 0.5 * kTrackThickness}))));
+  // Rails 10 mm above the track and 6 mm into the cut wall below it (no seam for a nut). The
+  // inner one runs the whole length too: the field w x r has an inward component along the
+  // straight track, and a nut pushed off its inner edge would fall 60 mm into the bowl.
+  const double rail_top = 0.010, rail_bottom = layout.outlet_wall_top - 0.006 - top,
+               rail = 0.011;  // as thick as a falling nut needs (the scene check)
+  for (double rail_x :
+       {kInnerRadius + 0.001 + 0.5 * rail, kInnerRadius - kTrackWidth - 0.5 * rail}) {
+    bowl.geoms.push_back(
+        box({rail, kOutletLength, rail_top - rail_bottom},
+            Pose::axisAngle({0, 0, 1}, 0,
+                            {rail_x, 0.5 * kOutletLength, top + 0.5 * (rail_top + rail_bottom)})));
+  }
+}
+
+// Screw vibration at 50 Hz: 0.15 mm vertical (A w^2 = 1.5 g: the nuts hop) and 0.17 degrees of
+// torsion (0.13 m/s peak tangential speed at r = 140 mm), as demos/scenes/bowl_feeder.json; the
+// rheonomic runs use the local vibration law (no calibration).
+FeederLaw screwVibration() {
+  FeederLaw law;
+  law.kind = FeederLaw::Kind::Vibration;
+  Vibration& v = law.vibration;
+  v.amplitude = 0.00015;
+  v.direction = {0, 0, 1};
+  v.torsion_amplitude = 0.17 * kDeg;
+  v.frequency = 50;
+  law.drift_model = DriftModel::Local;
+  return law;
+}
+
+// The bowls' run: mu = 0.3; full vibration at 100 steps per period, rheonomic runs at the paper's
+// 0.01 s; seed 7; parts below z = -0.1 m leave; the angular drift about +z after 1 s; with the
+// outlet, the exit plane tangent to r = kExitRadius at azimuth 45 degrees.
+void setBowlRun(Scene& s, double duration, bool outlet) {
+  s.material.mu = 0.3;
+  s.solver.time_step = 0.0002;  // full vibration: 100 steps per period
+  s.solver.rheonomic_time_step = 0.01;
+  s.solver.iterations = 40;
+  s.duration = duration;
+  s.seed = 7;
+  s.removal_height = -0.1;
+  s.outputs.angular_drift = true;
+  s.outputs.sample_interval = 0.05;
+  s.outputs.warmup = 1;
+  if (outlet) {
+    s.outputs.exit_plane = true;
+    const Vec3 n{std::cos(45 * kDeg), std::sin(45 * kDeg), 0};
+    s.outputs.exit_normal = n;
+    s.outputs.exit_point = kExitRadius * n;
+  }
 }
 
 }  // namespace
@@ -165,102 +305,17 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
   ramp.pitch = kPitch;
   ramp.turns = kTurns;
   ramp.segments_per_turn = kTrackSegments;
-  ramp.z_start = kRampStart;
+  ramp.z_start = kBoxBowl.track_top_start;
   ramp.outward_tilt = kTrackTilt;
   for (const Fixture::Geom& g : helicalTrack(ramp)) bowl.geoms.push_back(g);
 
-  if (outlet) {
-    // Wiper: a blade across the last turn, kWiperClearance above the track, running from the
-    // wall forwards and inwards at kWiperAngle. Nuts lying flat (5 mm) pass under it; nuts on
-    // edge (9-11 mm) or riding on another nut hit it, slide along it and fall off the track's
-    // inner edge back into the bowl. Its bottom follows the track's top (which rises along the
-    // helix and falls towards the wall, a few mm over the blade's length): under a level blade a
-    // 9 mm cube slid along it and passed where its top overlapped the blade by about 1 mm. Its
-    // outer end lies in the wall: the end face (square to the blade) has one corner 1.6 mm into
-    // the wall and the other beyond its outer face.
-    const double blade_height = 0.020, blade_thickness = 0.012;
-    const double phi0 = 2 * kPi + kWiperAzimuth;
-    const double r0 = kInnerRadius + 0.001 + 0.5 * blade_thickness * std::cos(kWiperAngle),
-                 r1 = kInnerRadius - kTrackWidth - 0.004;
-    const double along = (r0 - r1) / std::tan(kWiperAngle);
-    const double phi1 = phi0 + along / trackCentre();
-    // The track's top at radius r, azimuth phi (it falls outwards at kTrackTilt).
-    const auto top_at = [](double r, double phi) {
-      return trackTop(phi) - std::tan(kTrackTilt) * (r - trackCentre());
-    };
-    const Vec3 p0{r0 * std::cos(phi0), r0 * std::sin(phi0), top_at(r0, phi0) + kWiperClearance};
-    const Vec3 p1{r1 * std::cos(phi1), r1 * std::sin(phi1), top_at(r1, phi1) + kWiperClearance};
-    const Vec3 d = p1 - p0;  // along the blade's bottom edge
-    const double level = std::hypot(d.x, d.y);
-    const Pose yaw = Pose::axisAngle({0, 0, 1}, std::atan2(d.y, d.x));
-    const Pose pitch = Pose::axisAngle({0, 1, 0}, -std::atan2(d.z, level));
-    const Pose blade = composed(yaw, pitch, Vec3{});
-    bowl.geoms.push_back(
-        box({norm(d), blade_thickness, blade_height},
-            composed(yaw, pitch, 0.5 * (p0 + p1) + blade.rotate({0, 0, 0.5 * blade_height}))));
+  if (outlet) addTooling(bowl, kBoxBowl);
 
-    // Return chute: a plate under the wiper's drop zone, from just below the ramp's inner
-    // edge down inwards at 35 degrees (> atan(mu), so nuts slide) to the cone. A wiped nut
-    // falls about 10 mm onto it instead of 50 mm onto the cone's foot (1 m/s, 10 mm per step:
-    // its centre crossed the cone's surface for a step). Its top edge stays 5 mm inside the
-    // ramp's inner edge and it is 6 mm thick and 50 mm wide, so that no part of it hangs lower
-    // than 7 mm over the turn below (a 12 mm plate 70 mm wide reached down to that track's top
-    // and jammed the nuts climbing under it).
-    const double chute_slope = 35 * kDeg, chute_thickness = 0.006;
-    const double r_top = kInnerRadius - kTrackWidth - 0.005;
-    const double z_top = trackTop(phi0) - kTrackThickness - 0.003;
-    // Where the plate's top meets the cone: z_top - (r_top - r) tan(chute) = cone(r).
-    const double r_meet =
-        (kFloorTop + kConeOuter * std::tan(kConeSlope) - z_top + r_top * std::tan(chute_slope)) /
-        (std::tan(chute_slope) + std::tan(kConeSlope));
-    const double run = r_top - r_meet + 0.004;  // 4 mm into the cone
-    const double chute_az = phi0 + 0.5 * (phi1 - phi0) + 5 * kDeg;
-    const Vec3 inward{-std::cos(chute_az), -std::sin(chute_az), 0};
-    const Vec3 top_mid = (r_top - 0.5 * run) * Vec3{std::cos(chute_az), std::sin(chute_az), 0} +
-                         Vec3{0, 0, z_top - 0.5 * run * std::tan(chute_slope)};
-    const Vec3 up_normal = std::sin(chute_slope) * inward + Vec3{0, 0, std::cos(chute_slope)};
-    // Rz(azimuth + pi) Ry(chute): local x runs down the plate, inwards; local z is its normal.
-    bowl.geoms.push_back(box({run / std::cos(chute_slope), 0.050, chute_thickness},
-                             composed(Pose::axisAngle({0, 0, 1}, chute_az + kPi),
-                                      Pose::axisAngle({0, 1, 0}, chute_slope),
-                                      top_mid - 0.5 * chute_thickness * up_normal)));
-
-    // Outlet: a straight track leaving the ramp's top tangentially (+y at azimuth 0), through
-    // the cut-down wall, with a rail on each side.
-    const double top = trackTop(2 * kPi * kTurns);
-    const Pose roll = Pose::axisAngle({0, 1, 0}, kTrackTilt);  // top falls outwards (+x)
-    const double x = trackCentre() + 0.0005;
-    bowl.geoms.push_back(box(
-        {kTrackWidth + 0.001, kOutletLength, kTrackThickness},
-        composed(roll, Pose{},
-                 Vec3{x, 0.5 * kOutletLength, top} - roll.rotate({0, 0, 0.5 * kTrackThickness}))));
-    // Rails 10 mm above the track and 6 mm into the cut wall below it (no seam for a nut). The
-    // inner one runs the whole length too: the field w x r has an inward component along the
-    // straight track, and a nut pushed off its inner edge would fall 60 mm into the bowl.
-    const double rail_top = 0.010, rail_bottom = kOutletWallTop - 0.006 - top,
-                 rail = 0.011;  // as thick as a falling nut needs (the scene check)
-    for (double rail_x :
-         {kInnerRadius + 0.001 + 0.5 * rail, kInnerRadius - kTrackWidth - 0.5 * rail}) {
-      bowl.geoms.push_back(box(
-          {rail, kOutletLength, rail_top - rail_bottom},
-          Pose::axisAngle({0, 0, 1}, 0,
-                          {rail_x, 0.5 * kOutletLength, top + 0.5 * (rail_top + rail_bottom)})));
-    }
-  }
-
-  // Screw vibration at 50 Hz: 0.15 mm vertical (A w^2 = 1.5 g: the nuts hop) and 0.17 degrees
-  // of torsion (0.13 m/s peak tangential speed at r = 140 mm), as demos/scenes/bowl_feeder.json.
-  bowl.law.kind = FeederLaw::Kind::Vibration;
-  Vibration& v = bowl.law.vibration;
-  v.amplitude = 0.00015;
-  v.direction = {0, 0, 1};
-  v.torsion_amplitude = 0.17 * kDeg;
-  v.frequency = 50;
+  bowl.law = screwVibration();
   // The rheonomic runs: the local vibration law (no calibration). The former calibrated drift of
   // demos/scenes/bowl_feeder.json's ramp (same vibration, nuts and mu; measured while ODE kept 8
   // contacts per mesh pair, and since recalibrated there to 0.212 rad/s) stays in the scene for
   // `--drift-model calibrated_drift` and as the rotation the tooling tests' kinematics use.
-  bowl.law.drift_model = DriftModel::Local;
   bowl.law.has_calibrated_drift = true;
   bowl.law.calibrated_drift.angular = {0, 0, 0.313};
   s.fixtures.push_back(bowl);
@@ -285,22 +340,45 @@ Scene bowlFeederScene(int nuts, double rate, bool outlet, double duration) {
   p.spawn_min = {0.0, -0.100, 0.0348};
   p.spawn_max = {0.02, -0.090, 0.0368};
   s.parts.push_back(p);
-  s.material.mu = 0.3;
-  s.solver.time_step = 0.0002;  // full vibration: 100 steps per period
-  s.solver.rheonomic_time_step = 0.01;
-  s.solver.iterations = 40;
-  s.duration = duration;
-  s.seed = 7;
-  s.removal_height = -0.1;
-  s.outputs.angular_drift = true;
-  s.outputs.sample_interval = 0.05;
-  s.outputs.warmup = 1;
-  if (outlet) {
-    s.outputs.exit_plane = true;
-    const Vec3 n{std::cos(45 * kDeg), std::sin(45 * kDeg), 0};
-    s.outputs.exit_normal = n;
-    s.outputs.exit_point = kExitRadius * n;
-  }
+  setBowlRun(s, duration, outlet);
+  return s;
+}
+
+Scene meshBowlFeederScene(int nuts, double rate, double duration) {
+  Scene s;
+  s.name = "bowl_feeder_mesh_fill";
+  Fixture bowl;
+  bowl.name = "bowl";
+  // The bowl, its central cone and its ramp: one mesh (mm), with the wall cut for the outlet.
+  Fixture::Geom body;
+  body.shape.kind = Shape::Kind::Mesh;
+  body.shape.mesh = "../meshes/vibratory_bowl_outlet.stl";
+  body.shape.mesh_scale = 0.001;
+  bowl.geoms.push_back(body);
+  addTooling(bowl, kMeshBowl);
+  bowl.law = screwVibration();
+  s.fixtures.push_back(bowl);
+
+  // M6 nut blanks read from their mesh (mm), colliding as their convex hull (the plain hexagonal
+  // prism: nothing in this bowl enters the 6 mm hole); mass and inertia from the mesh (2.3 g).
+  // 3 % size spread, cut at +-10 %.
+  PartSpec p;
+  p.name = "m6_nuts";
+  p.shape = Shape::Kind::Mesh;
+  p.mesh = "../meshes/hex_nut_m6.obj";
+  p.collision = PartSpec::Collision::ConvexHull;
+  p.size[0] = {0.001, 0.00003, 0.0009, 0.0011};  // scale: mm to m
+  p.density = 7850;
+  p.random_orientation = true;
+  p.count = nuts;
+  p.rate = rate;
+  // Dropped one by one onto the cone (at r = 90..102 mm, where its surface is 22..28 mm high)
+  // from at most 15 mm above it; a nut's corners reach 6.9 mm from its centre at the largest
+  // size.
+  p.spawn_min = {0.0, -0.100, 0.0350};
+  p.spawn_max = {0.02, -0.090, 0.0370};
+  s.parts.push_back(p);
+  setBowlRun(s, duration, true);
   return s;
 }
 

@@ -93,6 +93,21 @@ std::vector<Fixture::Geom> helicalTrack(const HelicalTrack& track);
 /// = 0.3. Named bowl_feeder_fill above 12 nuts, else bowl_feeder_primitives.
 Scene bowlFeederScene(int nuts = 12, double rate = 4, bool outlet = true, double duration = 60);
 
+/// The bowl feeder as a mesh with the tooling of bowlFeederScene: the bowl
+/// (demos/meshes/vibratory_bowl_outlet.stl, millimetres scaled by 0.001; generate_meshes.cpp):
+/// inner radius 150 mm, wall 5 mm thick and 100 mm high, cut down to 64 mm over azimuth
+/// -0.5..40 degrees for the outlet, a floor falling 4 degrees towards the wall, a central cone of
+/// revolution (25 degrees from the floor at r = 124 mm up to a flat top of radius 70 mm at z = 37
+/// mm), and a helical ramp (20 mm wide, r = 130..150 mm, 4 mm thick, pitch 30 mm, 2 turns
+/// counter-clockwise from the floor at azimuth 0, its top falling 3 degrees towards the wall); the
+/// wiper, return chute, outlet track and rails of bowlFeederScene as boxes, fitted to this ramp
+/// and cone; its screw vibration on the local law; the exit plane tangent to r = 175 mm at 45
+/// degrees. `nuts` M6 nuts read from demos/meshes/hex_nut_m6.obj (2.3 g), colliding as their
+/// convex hull, dropped one by one at `rate` parts/s (> 0) from at most 15 mm above the cone.
+/// `duration` (s); mu = 0.3; h = 0.01 s for rheonomic runs. The mesh paths are relative to
+/// demos/scenes/: the scene is meant to be written there (dump_builtin_scene) and loaded.
+Scene meshBowlFeederScene(int nuts = 200, double rate = 5, double duration = 300);
+
 /// A static ring of `count` upright boxes about the world z axis (a turntable's rim): box centres
 /// on a circle of radius `centre_radius` (m) at height `z_centre` (m), each `thickness` (m)
 /// radially and `height` (m) tall, and wide enough tangentially to close the ring at

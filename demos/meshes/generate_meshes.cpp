@@ -9,11 +9,17 @@
 //                       thick, pitch 30 mm per turn, 2 turns, right-handed (it rises
 //                       counter-clockwise seen from +z), its top tilted 3 degrees down towards
 //                       the wall. Two closed shells: the bowl body and the ramp, which overlaps
-//                       the wall by 1 mm.
+//                       the wall by 1 mm. (bowl_feeder.json; its central cone is boxes.)
+//   vibratory_bowl_outlet.stl  the same bowl with its central cone in the body (a cone of
+//                       revolution falling 25 degrees from a flat top of radius 70 mm at z = 37 mm
+//                       to the floor at r = 124 mm) and the wall cut down to 64 mm over azimuth
+//                       -0.5..40 degrees, where the outlet track of bowl_feeder_mesh_fill.json
+//                       leaves the ramp's top. Two closed shells, as above.
 //   hex_nut_m6.obj      an M6 hex nut blank: 10 mm across flats, 5 mm thick, a 6 mm hole (a
 //                       24-gon), centred on the origin, axis +z. One closed shell.
 // Every shell is closed and its triangles are counter-clockwise seen from outside (outward
 // normals), so the part's volume and inertia follow from its surface (mesh.hpp).
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -89,40 +95,95 @@ void sweep(Mesh& mesh, int sections, bool closed, Section section, int profile_s
   }
 }
 
-Mesh bowl() {
-  const double radius = 150, wall = 5, height = 100, bottom = 10;
-  const double cone = 4 * kPi / 180;                       // floor rises towards the centre
-  const double centre = bottom + radius * std::tan(cone);  // floor height on the axis
-  const int segments = 128;
-  Mesh mesh;
-  // Body: revolution of the wall-and-floor section.
-  const std::vector<ProfilePoint> body = {
-      {0, 0},           {radius + wall, 0}, {radius + wall, height},
-      {radius, height}, {radius, bottom},   {0, centre}};
-  sweep(
-      mesh, segments, true,
-      [&](int j, double& phi) {
-        phi = 2 * kPi * j / segments;
-        return body;
-      },
-      static_cast<int>(body.size()));
+// The bowl's common dimensions (mm).
+constexpr double kRadius = 150, kWall = 5, kHeight = 100, kBottom = 10;
+constexpr double kFloorSlope = 4 * kPi / 180;  // the floor rises towards the centre
+constexpr int kSegments = 128;                 // facets of the solids of revolution
 
-  // Ramp: a helix of a trapezoid section from the floor at the wall, 2 turns up.
+// The helical ramp on the inner wall: a trapezoid section swept from the floor at azimuth 0, 2
+// turns up (right-handed), its outer edge 1 mm into the wall, its top falling 3 degrees towards
+// the wall; the top's outer edge at r = 150 mm rises from z = 10 mm by 30 mm per turn.
+void addRamp(Mesh& mesh) {
   const double width = 20, thickness = 4, pitch = 30, turns = 2, overlap = 1;
-  const double tilt = 3 * kPi / 180;  // top falls towards the wall
-  const int ramp_sections = static_cast<int>(segments * turns) + 1;
+  const double tilt = 3 * kPi / 180;
+  const int ramp_sections = static_cast<int>(kSegments * turns) + 1;
   sweep(
       mesh, ramp_sections, false,
       [&](int j, double& phi) {
         phi = 2 * kPi * turns * j / (ramp_sections - 1);
-        const double top = bottom + pitch * phi / (2 * kPi);
-        const double r_in = radius - width, r_out = radius + overlap;
+        const double top = kBottom + pitch * phi / (2 * kPi);
+        const double r_in = kRadius - width, r_out = kRadius + overlap;
         return std::vector<ProfilePoint>{{r_in, top - thickness},
                                          {r_out, top - thickness},
                                          {r_out, top - overlap * std::tan(tilt)},
                                          {r_in, top + width * std::tan(tilt)}};
       },
       4);
+}
+
+// The bowl of bowl_feeder.json: the wall and a floor rising 4 degrees to the axis (the scene
+// adds its central cone as boxes), and the ramp.
+Mesh bowl() {
+  const double centre = kBottom + kRadius * std::tan(kFloorSlope);  // floor height on the axis
+  Mesh mesh;
+  const std::vector<ProfilePoint> body = {{0, 0},
+                                          {kRadius + kWall, 0},
+                                          {kRadius + kWall, kHeight},
+                                          {kRadius, kHeight},
+                                          {kRadius, kBottom},
+                                          {0, centre}};
+  sweep(
+      mesh, kSegments, true,
+      [&](int j, double& phi) {
+        phi = 2 * kPi * j / kSegments;
+        return body;
+      },
+      static_cast<int>(body.size()));
+  addRamp(mesh);
+  return mesh;
+}
+
+// The bowl of bowl_feeder_mesh_fill.json: as bowl(), with the central cone turned into the body
+// (25 degrees, steeper than the friction angle, from the floor at r = 124 mm, z = 11.8 mm, up to a
+// flat top of radius 70 mm at z = 37.0 mm) and the wall cut down to 64 mm over azimuth -0.5..40
+// degrees, where the scene's outlet track leaves the ramp's top through it (the cut's sides slope
+// over 1 degree).
+Mesh bowlWithOutlet() {
+  const double cone_outer = 124, cone_inner = 70, cone_slope = 25 * kPi / 180;
+  const double cut_from = -0.5, cut_to = 40, cut_top = 64, ramp_deg = 1;  // degrees, mm
+  const double foot = kBottom + (kRadius - cone_outer) * std::tan(kFloorSlope);
+  const double plateau = foot + (cone_outer - cone_inner) * std::tan(cone_slope);
+  // Section angles (degrees): the uniform ones, with the cut's four corners put in and the
+  // uniform angles within 0.3 degrees of them left out.
+  const std::vector<double> corners = {cut_from - ramp_deg, cut_from, cut_to, cut_to + ramp_deg};
+  std::vector<double> angles;
+  for (int j = 0; j < kSegments; ++j) {
+    double a = 360.0 * j / kSegments;
+    if (a > 180) a -= 360;
+    bool near = false;
+    for (double c : corners) near = near || std::abs(a - c) < 0.3;
+    if (!near) angles.push_back(a);
+  }
+  angles.insert(angles.end(), corners.begin(), corners.end());
+  std::sort(angles.begin(), angles.end());
+  Mesh mesh;
+  sweep(
+      mesh, static_cast<int>(angles.size()), true,
+      [&](int j, double& phi) {
+        const double a = angles[static_cast<std::size_t>(j)];
+        phi = a * kPi / 180;
+        const double top = a >= cut_from && a <= cut_to ? cut_top : kHeight;
+        return std::vector<ProfilePoint>{{0, 0},
+                                         {kRadius + kWall, 0},
+                                         {kRadius + kWall, top},
+                                         {kRadius, top},
+                                         {kRadius, kBottom},
+                                         {cone_outer, foot},
+                                         {cone_inner, plateau},
+                                         {0, plateau}};
+      },
+      8);
+  addRamp(mesh);
   return mesh;
 }
 
@@ -196,6 +257,10 @@ int main(int argc, char** argv) {
     writeBinaryStl(dir + "/vibratory_bowl.stl", b,
                    "rheofeed vibratory bowl, mm, generate_meshes.cpp");
     std::cout << dir << "/vibratory_bowl.stl: " << b.triangles.size() << " triangles\n";
+    const Mesh o = bowlWithOutlet();
+    writeBinaryStl(dir + "/vibratory_bowl_outlet.stl", o,
+                   "rheofeed vibratory bowl with cone and outlet cut, mm, generate_meshes.cpp");
+    std::cout << dir << "/vibratory_bowl_outlet.stl: " << o.triangles.size() << " triangles\n";
     const Mesh n = hexNut();
     writeObj(dir + "/hex_nut_m6.obj", n,
              "rheofeed M6 hex nut blank, mm, 10 across flats, 5 thick, 6 hole (24-gon); "

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The bowl feeder built from primitives (bowlFeederScene, demos/common/bowl_scene.cpp): its
 // shipped files are the built-in scene, twelve nuts stay in it, and its tooling and outlet pass
-// nuts lying flat and stop taller parts; and the mesh bowl (bowl_feeder.json) keeps its nuts. The
+// nuts lying flat and stop taller parts; the mesh bowl (bowl_feeder.json) keeps its nuts; and the
+// mesh bowl with the same tooling (bowl_feeder_mesh_fill.json) passes flat mesh nuts only. The
 // expectations come from the scene's geometry (the wiper's clearance against a part's height, path
 // lengths) and the kinematics of the drift it is given (a part carried by a surface turning at w
 // about the axis moves at w r; the real vibration's peak surface speed bounds any conveying speed,
@@ -59,6 +60,15 @@ TEST(BowlFeeder, ShippedFilesAreTheBuiltInScenes) {
     shipped.drift_table.clear();
     EXPECT_EQ(toJson(shipped), toJson(parseScene(toJson(scene), "built-in")));
   }
+  // The mesh bowl names its meshes relative to demos/scenes/, where it is written: parsed as if
+  // there, both read the same meshes and store them by absolute path.
+  const std::filesystem::path mesh_file = dir / "bowl_feeder_mesh_fill.json";
+  Scene shipped = loadScene(mesh_file);
+  ASSERT_NE(shipped.drift_table_corners, nullptr);
+  shipped.drift_table.clear();
+  Scene built = parseScene(toJson(meshBowlFeederScene()), mesh_file.string());
+  built.drift_table.clear();
+  EXPECT_EQ(toJson(shipped), toJson(built));
 }
 
 // Runs `s` rheonomic at its own step, which must be 0.01 s (the simulated step, the paper's),
@@ -144,19 +154,23 @@ TEST(BowlFeeder, MeshBowlRunsTheSameFromAnyFolder) {
   }
 }
 
-TEST(BowlFeederTooling, FlatNutsPassTheWiperAtTheDriftSpeedAndTallPartsDoNot) {
-  Scene s = bowlFeederScene(4, 1, true);
-  // The kinematics below are those of the scene's calibrated drift (a rigid rotation at w).
-  overrideDriftModel(s, DriftModel::CalibratedDrift);
-  // Four nuts lying flat, dropped one a second onto the last turn 60 degrees before the wiper.
-  PartSpec& nuts = s.parts[0];
+// Where the wiper trials drop their parts: on the last turn, 60 and 100 degrees before the wiper.
+constexpr double kTrialStartDeg = 240;
+
+// Runs `s` rheonomic at 0.01 s with its nuts replaced by four lying flat, dropped one a second at
+// on_last_turn(kTrialStartDeg, 4 mm), and behind them three 9 mm cubes: 9 mm high whichever way
+// they lie, more than the wiper's clearance, as a nut on edge (9-11.5 mm) or a nut riding on
+// another (>= 9 mm). Every nut must leave through the outlet lying flat, no cube may, and no part
+// may be lost. Returns the metrics.
+template <class OnLastTurn>
+RunMetrics runWiperTrial(Scene s, OnLastTurn on_last_turn, double duration) {
+  PartSpec& nuts = s.parts.at(0);
   nuts.random_orientation = false;
-  const double start_deg = 240;
-  nuts.spawn_min = nuts.spawn_max = onLastTurn(start_deg, 0.004);
-  // Behind them, three 9 mm cubes: 9 mm high whichever way they lie, more than the wiper's
-  // clearance, as a nut on edge (9-11.5 mm) or a nut riding on another (>= 9 mm).
+  nuts.count = 4;
+  nuts.rate = 1;
+  nuts.spawn_min = nuts.spawn_max = on_last_turn(kTrialStartDeg, 0.004);
   constexpr double kCube = 0.009;
-  ASSERT_GT(kCube, kWiperClearance);
+  EXPECT_GT(kCube, kWiperClearance);
   PartSpec cubes;
   cubes.name = "cubes";
   cubes.shape = Shape::Kind::Box;
@@ -164,15 +178,16 @@ TEST(BowlFeederTooling, FlatNutsPassTheWiperAtTheDriftSpeedAndTallPartsDoNot) {
   cubes.density = 7850;
   cubes.count = 3;
   cubes.rate = 1;
-  cubes.spawn_min = cubes.spawn_max = onLastTurn(start_deg - 40, 0.5 * kCube + 0.002);
+  cubes.spawn_min = cubes.spawn_max = on_last_turn(kTrialStartDeg - 40, 0.5 * kCube + 0.002);
   s.parts.push_back(cubes);
-  s.duration = 14;
+  s.duration = duration;
   s.outputs.warmup = 0.5;
   const Scene run = atRunStep(s, runStep(s, Method::OdeRheonomic));
-  ASSERT_DOUBLE_EQ(run.solver.time_step, 0.01);
+  EXPECT_DOUBLE_EQ(run.solver.time_step, 0.01);
   const RunMetrics r = measureRun(run, Method::OdeRheonomic);
 
-  ASSERT_EQ(r.feeder.families.size(), 2u);
+  EXPECT_EQ(r.feeder.families.size(), 2u);
+  if (r.feeder.families.size() != 2) return r;
   const FamilyExits& n = r.feeder.families[0];
   const FamilyExits& c = r.feeder.families[1];
   EXPECT_EQ(n.exited, 4);
@@ -182,6 +197,16 @@ TEST(BowlFeederTooling, FlatNutsPassTheWiperAtTheDriftSpeedAndTallPartsDoNot) {
   EXPECT_EQ(c.spawned, 3);
   EXPECT_EQ(c.exited, 0);
   EXPECT_EQ(r.health.partsLost(), 0);
+  EXPECT_EQ(r.health.parts_sunk, 0);
+  return r;
+}
+
+TEST(BowlFeederTooling, FlatNutsPassTheWiperAtTheDriftSpeedAndTallPartsDoNot) {
+  Scene s = bowlFeederScene(4, 1, true);
+  // The kinematics below are those of the scene's calibrated drift (a rigid rotation at w).
+  overrideDriftModel(s, DriftModel::CalibratedDrift);
+  const RunMetrics r = runWiperTrial(s, onLastTurn, 14);
+  const double start_deg = kTrialStartDeg;
 
   // The first nut's path: the rest of the last turn at the riding radius, then the outlet
   // track (x = 140.5 mm +- 10 mm, along +y) up to the exit plane (tangent to r = 175 mm at
@@ -200,6 +225,34 @@ TEST(BowlFeederTooling, FlatNutsPassTheWiperAtTheDriftSpeedAndTallPartsDoNot) {
   // Slip on the turn, the wiper's deflection and the outlet's inward field cost at most a
   // third (a stuck or slowed nut would take longer).
   EXPECT_LT(r.feeder.first_exit_time, drop + 1.35 * path / drift_speed);
+}
+
+// The mesh bowl with the same tooling (bowl_feeder_mesh_fill.json, meshBowlFeederScene): its
+// ramp is part of the bowl's mesh (4 mm thick, the top's outer edge at the wall rising from z = 10
+// mm by 30 mm per turn and falling 3 degrees towards the wall: generate_meshes.cpp), its nuts are
+// read from their mesh and collide as their convex hull, and it runs on the local vibration law,
+// which has no drift to derive a speed from: the nuts lying flat must reach the outlet and leave
+// lying flat, the 9 mm cubes must not pass the wiper, no part may pass through the bowl's thin
+// shell, and no part may be faster than the vibration's peak surface speed allows.
+TEST(BowlFeederTooling, MeshBowlPassesFlatMeshNutsAndStopsTallPartsOnTheLocalLaw) {
+  Scene s =
+      loadScene(std::filesystem::path(RHEOFEED_DEMO_DIR) / "scenes" / "bowl_feeder_mesh_fill.json");
+  ASSERT_EQ(s.fixtures[0].law.drift_model, DriftModel::Local);
+  const double ride = 0.1445;  // m: a nut leaning on the wall, 5.5 mm from it at mid-height
+  const auto on_last_turn = [ride](double azimuth_deg, double above) {
+    const double a = azimuth_deg * kDeg;
+    const double top =
+        0.010 + 0.030 * (2 * kPi + a) / (2 * kPi) + (0.150 - ride) * std::tan(3 * kDeg);
+    return Vec3{ride * std::cos(a), ride * std::sin(a), top + above};
+  };
+  // Four nuts lying flat (the mesh's axis is +z) and three 9 mm cubes, 45 s.
+  const RunMetrics r = runWiperTrial(s, on_last_turn, 45);
+  const double start_deg = kTrialStartDeg;
+  // The rest of the last turn and the outlet track up to the exit plane, at no more than the
+  // vibration's peak torsional surface speed (0.17 degrees at 50 Hz, at r <= 160 mm).
+  const double path = (360 - start_deg) * kDeg * ride +
+                      (0.175 - 0.1405 * std::cos(45 * kDeg)) / std::sin(45 * kDeg);
+  EXPECT_GT(r.feeder.first_exit_time, path / (0.17 * kDeg * 2 * kPi * 50 * 0.16));
 }
 
 }  // namespace
