@@ -356,6 +356,63 @@ TEST(SceneCheck, SpawnInsideAFixtureAndBelowTheRemovalHeightFire) {
   EXPECT_EQ(r[0].value, 0.006);
 }
 
+// A closed fixture mesh is the solid it bounds: a spawn region inside the bowl's central cone
+// or its wall is named, the bowl's cavity is not. The cone's surface from the bowl's generator
+// (generate_meshes.cpp): z = 11.8 mm at r = 124 mm, rising 25 degrees inwards; at r = 90..102 mm
+// it is 22..28 mm high. (The check skipped every mesh until a new user's nuts, spawned inside the
+// cone, were all lost as "tunnelled" with no warning.)
+TEST(SceneCheck, SpawnInsideAClosedMeshFixtureFires) {
+  const std::filesystem::path dir = std::filesystem::path(RHEOFEED_DEMO_DIR) / "scenes";
+  Scene s = loadScene(dir / "bowl_feeder_mesh_fill.json");
+  ASSERT_EQ(s.fixtures[0].geoms[0].shape.kind, Shape::Kind::Mesh);
+  EXPECT_TRUE(
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture).empty());
+  s.parts[0].spawn_min.z = 0.020;  // below the cone's surface over r = 90..96 mm
+  s.parts[0].spawn_max.z = 0.021;
+  std::vector<Hazard> inside =
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture);
+  ASSERT_EQ(inside.size(), 1u);
+  EXPECT_NE(inside[0].where.find("fixtures[0].geoms[0]"), std::string::npos) << inside[0].where;
+  // A region 3 mm across inside the 5 mm wall (r = 150..155 mm), on -x at z = 80 mm (on +x
+  // the wall is cut down to 64 mm for the outlet).
+  s.parts[0].spawn_min = {-0.154, -0.001, 0.080};
+  s.parts[0].spawn_max = {-0.151, 0.001, 0.082};
+  EXPECT_EQ(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture).size(),
+            1u);
+  // The same region moved 3 mm inwards, into the cavity: quiet.
+  s.parts[0].spawn_min.x = -0.149;
+  s.parts[0].spawn_max.x = -0.146;
+  EXPECT_TRUE(
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture).empty());
+}
+
+// Parts spawned faster than they fall clear of each other overlap unless the region holds them
+// side by side. An M6 nut is 11.5 mm across its corners (10 mm across flats / cos 30 degrees) and
+// falls that far in sqrt(2 s / g) = 48 ms: the shipped 5 per second from a 20 mm region is
+// quiet; 50 per second from a 10 mm region, and a rate that spawns every nut within one step,
+// are named. (The check took a mesh part's thickness, 5 mm, as its size: 50 per second from 10
+// mm passed.)
+TEST(SceneCheck, SpawnStreamOverlapCountsTheRegionAgainstAMeshPartsWidth) {
+  const std::filesystem::path dir = std::filesystem::path(RHEOFEED_DEMO_DIR) / "scenes";
+  Scene s = loadScene(dir / "bowl_feeder_mesh_fill.json");
+  ASSERT_EQ(s.parts[0].shape, Shape::Kind::Mesh);
+  EXPECT_TRUE(
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnStreamOverlap).empty());
+  const double across_corners = 0.010 / std::cos(kPi / 6);
+  const double fall = std::sqrt(2 * across_corners / kG);  // s, at the mean scale
+  s.parts[0].rate = 50;
+  s.parts[0].spawn_max.x = s.parts[0].spawn_min.x + 0.010;
+  std::vector<Hazard> h =
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnStreamOverlap);
+  ASSERT_EQ(h.size(), 1u);
+  EXPECT_GT(h[0].limit, 0.95 * fall);  // the scale spread reaches below the mean
+  EXPECT_DOUBLE_EQ(h[0].value, 1.0 / 50);
+  s = loadScene(dir / "bowl_feeder_mesh_fill.json");
+  s.parts[0].rate = 1e9;
+  EXPECT_EQ(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnStreamOverlap).size(),
+            1u);
+}
+
 TEST(SceneCheck, RestitutionNearOneIsNamed) {
   Scene s = beltScene();
   s.material.restitution = 1.0;

@@ -2,6 +2,7 @@
 // Geometry and part measures of the scene check (check_internal.hpp): bounding boxes, heights
 // along up, thicknesses, part size ranges, plan overlaps, spawn regions against fixtures.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -49,14 +50,13 @@ double minAlong(const Box3& b, const Vec3& up) {
   return -maxAlong(b, -up);
 }
 
-// Smallest extent of a mesh's bounding box in its own frame, times `scale` (m).
-double meshBoxExtent(const TriangleMesh& mesh, double scale) {
+// Extents of a mesh's bounding box in its own frame, times `scale` (m).
+Vec3 meshBoxExtents(const TriangleMesh& mesh, double scale) {
   Box3 b;
   for (std::size_t k = 0; k + 2 < mesh.vertices.size(); k += 3) {
     b.add({mesh.vertices[k], mesh.vertices[k + 1], mesh.vertices[k + 2]});
   }
-  const Vec3 e = b.hi - b.lo;
-  return scale * std::min({e.x, e.y, e.z});
+  return scale * (b.hi - b.lo);
 }
 
 // Thickness of a fixture geom (m): the smallest distance across it. Planes are half-spaces.
@@ -113,8 +113,9 @@ PartExtreme partExtreme(const PartSpec& p, const double sz[3], std::string* note
         return {0, 0, 0};
       }
       if (note) *note = " (mesh part: smallest bounding-box extent, an upper bound)";
-      const double extent = meshBoxExtent(*p.mesh_data, sz[0]);
-      return {massProperties(*p.mesh_data, rho).mass * std::pow(sz[0], 3), extent, extent};
+      const Vec3 e = meshBoxExtents(*p.mesh_data, sz[0]);
+      return {massProperties(*p.mesh_data, rho).mass * std::pow(sz[0], 3),
+              std::min({e.x, e.y, e.z}), std::max({e.x, e.y, e.z})};
     }
     case Shape::Kind::Plane:
       break;
@@ -180,6 +181,93 @@ bool upright(const Fixture::Geom& g, const Vec3& up) {
   return false;
 }
 
+double windingNumber(const TriangleMesh& m, const Vec3& p) {
+  double sum = 0;
+  for (std::size_t t = 0; 3 * t + 2 < m.triangles.size(); ++t) {
+    Vec3 v[3];
+    for (int k = 0; k < 3; ++k) {
+      const double* x = &m.vertices[3 * static_cast<std::size_t>(m.triangles[3 * t + k])];
+      v[k] = Vec3{x[0], x[1], x[2]} - p;
+    }
+    const double la = norm(v[0]), lb = norm(v[1]), lc = norm(v[2]);
+    sum += 2 * std::atan2(dot(v[0], cross(v[1], v[2])), la * lb * lc + dot(v[0], v[1]) * lc +
+                                                            dot(v[1], v[2]) * la +
+                                                            dot(v[2], v[0]) * lb);
+  }
+  return sum / (4 * kPi);
+}
+
+bool closedMesh(const TriangleMesh& m) {
+  // Vertices at the same point are one (a loader may keep them apart, one per face).
+  const std::size_t n = m.vertices.size() / 3;
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  const auto point = [&m](std::size_t i) {
+    return std::array<double, 3>{m.vertices[3 * i], m.vertices[3 * i + 1], m.vertices[3 * i + 2]};
+  };
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return point(a) < point(b); });
+  std::vector<std::size_t> id(n);
+  for (std::size_t k = 0, next = 0; k < n; ++k) {
+    if (k > 0 && point(order[k]) != point(order[k - 1])) ++next;
+    id[order[k]] = next;
+  }
+  std::vector<std::pair<std::size_t, std::size_t>> edges, reversed;
+  for (std::size_t t = 0; 3 * t + 2 < m.triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t a = id[static_cast<std::size_t>(m.triangles[3 * t + k])],
+                        b = id[static_cast<std::size_t>(m.triangles[3 * t + (k + 1) % 3])];
+      edges.emplace_back(a, b);
+      reversed.emplace_back(b, a);
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  std::sort(reversed.begin(), reversed.end());
+  return !edges.empty() && std::adjacent_find(edges.begin(), edges.end()) == edges.end() &&
+         edges == reversed;
+}
+
+namespace {
+
+// Whether the region [lo, hi] (world) reaches into the solid bounded by the closed mesh `m`
+// placed at `pose`: a grid of points over the region (both ends of each axis and at most 5 mm
+// apart, up to 17 per axis) by winding number, and the mesh's vertices inside the region (a
+// wall thinner than the grid's spacing that crosses the region has corners in it when the
+// region holds one of its edges). A sampling check: it can miss a thin wall that crosses the
+// region between samples without a vertex in it.
+bool regionInsideMesh(const Vec3& lo, const Vec3& hi, const Pose& pose, const TriangleMesh& m) {
+  const auto local = [&pose](const Vec3& w) {
+    const Vec3 d = w - pose.position;
+    const double* r = pose.rotation;  // R^T d: world to the mesh's frame
+    return Vec3{r[0] * d.x + r[3] * d.y + r[6] * d.z, r[1] * d.x + r[4] * d.y + r[7] * d.z,
+                r[2] * d.x + r[5] * d.y + r[8] * d.z};
+  };
+  for (std::size_t k = 0; k + 2 < m.vertices.size(); k += 3) {
+    const Vec3 w = pose.transform({m.vertices[k], m.vertices[k + 1], m.vertices[k + 2]});
+    if (w.x > lo.x && w.x < hi.x && w.y > lo.y && w.y < hi.y && w.z > lo.z && w.z < hi.z) {
+      return true;
+    }
+  }
+  const auto samples = [](double extent) {
+    return std::clamp(static_cast<int>(std::ceil(extent / 0.005)) + 1, 2, 17);
+  };
+  const int n[3] = {samples(hi.x - lo.x), samples(hi.y - lo.y), samples(hi.z - lo.z)};
+  const auto at = [](double a, double b, int i, int count) {
+    return a + (b - a) * i / (count - 1);
+  };
+  for (int i = 0; i < n[0]; ++i) {
+    for (int j = 0; j < n[1]; ++j) {
+      for (int k = 0; k < n[2]; ++k) {
+        const Vec3 w{at(lo.x, hi.x, i, n[0]), at(lo.y, hi.y, j, n[1]), at(lo.z, hi.z, k, n[2])};
+        if (windingNumber(m, local(w)) > 0.5) return true;
+      }
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 // Whether the axis-aligned region [lo, hi] (world) reaches into a fixture geom.
 bool regionInsideGeom(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g) {
   const Shape& s = g.shape;
@@ -191,7 +279,15 @@ bool regionInsideGeom(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g) {
     }
     return lowest < 0;
   }
-  if (s.kind == Shape::Kind::Mesh) return false;  // hollow in general: not checked
+  if (s.kind == Shape::Kind::Mesh) {
+    if (!s.mesh_data || !closedMesh(*s.mesh_data)) return false;  // no solid: not checked
+    const Box3 b = geomBounds(g);
+    if (b.bounded && !(lo.x < b.hi.x && hi.x > b.lo.x && lo.y < b.hi.y && hi.y > b.lo.y &&
+                       lo.z < b.hi.z && hi.z > b.lo.z)) {
+      return false;
+    }
+    return regionInsideMesh(lo, hi, g.pose, *s.mesh_data);
+  }
   if (s.kind == Shape::Kind::Sphere) {
     const Vec3 c = g.pose.position;
     const Vec3 nearest{std::clamp(c.x, lo.x, hi.x), std::clamp(c.y, lo.y, hi.y),

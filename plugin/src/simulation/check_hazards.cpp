@@ -273,28 +273,36 @@ void checkSpawnStream(const CheckContext& c, std::size_t part, std::vector<Hazar
   const std::size_t i = part;
   const PartSpec& p = c.scene.parts[i];
   if (p.rate > 0 && p.count > 1 && c.g > 0) {
-    // A part released at rest falls its own largest size s in t = sqrt(2 s / g); the next
-    // one appears 1 / rate later. When it comes sooner, and the region is narrower than s
-    // across (so the next part cannot be drawn beside the last), they overlap.
+    // A part released at rest falls its own largest size s in t = sqrt(2 s / g); rate t more
+    // parts appear meanwhile. The region holds at most n = prod max(1, floor(span_i / s)) of
+    // them side by side; when more come (a narrow region and the next part within t, or a rate
+    // that spawns many parts within a step), they overlap.
     const PartRange r = partRange(p);
     const double s_big = r.heavy.size;
     const double clear_time = std::sqrt(2 * s_big / c.g);
     const double interval = 1.0 / p.rate;
     const Vec3 span = p.spawn_max - p.spawn_min;
     const double across = std::max({std::abs(span.x), std::abs(span.y), std::abs(span.z)});
-    if (interval < clear_time && across < s_big) {
+    double side_by_side = 1;
+    for (double extent : {span.x, span.y, span.z}) {
+      side_by_side *= std::max(1.0, std::floor(std::abs(extent) / s_big));
+    }
+    const double coming = std::min(p.rate * clear_time, static_cast<double>(p.count));
+    if (coming > side_by_side) {
       Hazard hz;
       hz.kind = Hazard::Kind::SpawnStreamOverlap;
       hz.value = interval;
-      hz.limit = clear_time;
+      hz.limit = clear_time / side_by_side;
       hz.where = idx("parts", i) + ".rate, " + idx("parts", i) + ".spawn_min/spawn_max";
       hz.message = idx("parts", i) + " ('" + p.name + "') spawns a part every " + fmt(interval) +
-                   " s from a region " + fmt(across) + " m across, smaller than a part (" +
-                   fmt(s_big) + " m), while a part needs " + fmt(clear_time) +
-                   " s to fall clear of the next: parts appear inside each other and are "
-                   "pushed apart at up to solver.max_correcting_velocity";
-      hz.safe_setting = idx("parts", i) + ".rate <= " + fmt(1.0 / clear_time) +
-                        " parts/s, or a spawn region at least " + fmt(s_big) + " m across";
+                   " s (" + fmt(coming) + " parts in the " + fmt(clear_time) +
+                   " s a part needs to fall its own size, " + fmt(s_big) + " m) from a region " +
+                   fmt(across) + " m across that holds " + fmt(side_by_side) +
+                   " side by side: parts appear inside each other and are pushed apart at up to "
+                   "solver.max_correcting_velocity";
+      hz.safe_setting = idx("parts", i) + ".rate <= " + fmt(side_by_side / clear_time) +
+                        " parts/s, or a larger spawn region (" + fmt(s_big) +
+                        " m per part along each axis)";
       out.push_back(hz);
     }
   }

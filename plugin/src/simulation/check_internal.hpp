@@ -77,7 +77,7 @@ Thickness fixtureThickness(const Shape& s);
 // Mass (kg) and smallest thickness (m) of a part of a family at given sizes.
 struct PartExtreme {
   double mass = 0, thickness = 0;
-  double size = 0;  // largest extent (m); a mesh part: its smallest bounding-box extent
+  double size = 0;  // largest extent (m); a mesh part: its largest bounding-box extent
 };
 struct PartRange {
   PartExtreme light, heavy;  // the lightest and heaviest parts of the family
@@ -90,7 +90,18 @@ PartRange partRange(const PartSpec& p);
 bool planOverlap(const Fixture::Geom& a, const Fixture::Geom& b, const Vec3& up);
 // Whether a geom is a box with an edge along `up`.
 bool upright(const Fixture::Geom& g, const Vec3& up);
-// Whether the axis-aligned region [lo, hi] (world) reaches into a fixture geom.
+// Generalized winding number of a closed mesh at p (its frame): the solid angles of its
+// triangles seen from p (Van Oosterom and Strackee), summed, over 4 pi. 1 inside an outward
+// mesh, 0 outside, whatever its edges and vertices.
+double windingNumber(const TriangleMesh& m, const Vec3& p);
+
+// Whether `m` is closed and consistently wound: every directed edge (a, b) of a triangle is met
+// exactly once by the reverse edge (b, a) of another, vertices at the same point counting as
+// one, so the mesh bounds a solid (or several).
+bool closedMesh(const TriangleMesh& m);
+
+// Whether the axis-aligned region [lo, hi] (world) reaches into a fixture geom. A closed mesh
+// is the solid it bounds, sampled (regionInsideMesh); an open one bounds none: false.
 bool regionInsideGeom(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g);
 // Largest surface speed of a drift twist over a box (m/s).
 double twistSpeedOver(const Twist& t, const Box3& b);

@@ -21,20 +21,6 @@ Vec3 meshVertex(const TriangleMesh& m, std::size_t triangle, int corner) {
   return {v[0], v[1], v[2]};
 }
 
-// Generalized winding number of a closed mesh at p: the solid angles of its triangles seen from
-// p (Van Oosterom and Strackee), summed, over 4 pi. 1 inside an outward mesh, 0 outside.
-double windingNumber(const TriangleMesh& m, const Vec3& p) {
-  double sum = 0;
-  for (std::size_t t = 0; 3 * t + 2 < m.triangles.size(); ++t) {
-    const Vec3 a = meshVertex(m, t, 0) - p, b = meshVertex(m, t, 1) - p,
-               c = meshVertex(m, t, 2) - p;
-    const double la = norm(a), lb = norm(b), lc = norm(c);
-    sum += 2 * std::atan2(dot(a, cross(b, c)),
-                          la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb);
-  }
-  return sum / (4 * kPi);
-}
-
 // Distance from p to the triangle (a, b, c): its closest point by the triangle's Voronoi
 // regions (Ericson, Real-Time Collision Detection, 5.1.5).
 double triangleDistance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -127,7 +113,8 @@ PartAnchor partAnchor(const Shape& shape) {
   partSizes(shape, anchor.clearance, radius);
   const std::shared_ptr<const TriangleMesh>& mesh =
       shape.collision_mesh_data ? shape.collision_mesh_data : shape.mesh_data;
-  if (shape.kind != Shape::Kind::Mesh || !mesh || windingNumber(*mesh, {}) > 0.5) return anchor;
+  if (shape.kind != Shape::Kind::Mesh || !mesh || checks::windingNumber(*mesh, {}) > 0.5)
+    return anchor;
   // Spans between consecutive crossings closer than this (m) are one crossing counted twice (a
   // ray through an edge or a vertex shared by several triangles).
   const double same = 1e-9 * radius;
@@ -155,7 +142,7 @@ PartAnchor partAnchor(const Shape& shape) {
     for (std::size_t j = 1; j < hits.size(); ++j) {
       if (hits[j] - hits[j - 1] <= same) continue;
       const Vec3 x = (0.5 * (hits[j - 1] + hits[j])) * d;
-      if (!(windingNumber(*mesh, x) > 0.5)) continue;
+      if (!(checks::windingNumber(*mesh, x) > 0.5)) continue;
       const double depth = meshDistance(*mesh, x);
       if (depth > deepest) {
         deepest = depth;
