@@ -95,8 +95,11 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kMinMargin = 1.0;             // m: smallest margin around the scene's extent
 constexpr double kTunnelCheckFraction = 1e-3;  // of the anchor's clearance, see above
 // Two crossings along one segment are distinct when they are this far apart (m): far below any
-// part or fixture size, far above the round-off of a ray test over a step.
-constexpr double kCrossingTolerance = 1e-9;
+// part or fixture size (at least 1e-5 m), far above the round-off of a ray test over a step.
+// ODE's ray against a triangle mesh (OPCODE) works in single precision: about 1e-8 m at 0.1 m
+// from the origin. With 1e-9, a mesh nut's anchor that ended 0.3 mm inside a mesh cone met the
+// cone's surface going in and, backwards, coming out 3 nm apart, and counted as passed through.
+constexpr double kCrossingTolerance = 1e-6;
 // An anchor that went into a fixture and out again passed through it when the exit surface faces
 // away from the entry surface: their outward normals more than 120 degrees apart (cosine below
 // -kThroughCosine). Out through a face at a right angle to the entry is a corner cut.
