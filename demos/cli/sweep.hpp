@@ -33,6 +33,8 @@
 #include <string>
 #include <vector>
 
+#include "rheofeed/output/plot.hpp"
+
 namespace rheofeed::cli::sweep {
 
 /// A parameter the sweep varies: a number in the scene, addressed by a JSON pointer (RFC 6901)
@@ -231,8 +233,8 @@ std::filesystem::path selfExe();
 /// std::runtime_error naming the program when it cannot be started.
 int spawnProcess(const std::vector<std::string>& argv, const std::filesystem::path& log = {});
 
-/// `text` quoted for a POSIX shell ('...', with ' as '\'').
-std::string shellQuoted(const std::string& text);
+/// `text` quoted for a POSIX shell (plot.hpp).
+using rheofeed::scene::shellQuoted;
 
 /// Installs SIGINT and SIGTERM handlers that record the signal and forward it to the processes
 /// registered with forwardSignalsTo (no SA_RESTART: a blocking wait returns with EINTR).

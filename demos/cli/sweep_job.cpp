@@ -228,12 +228,6 @@ int spawnProcess(const std::vector<std::string>& argv, const fs::path& log) {
   return pid;
 }
 
-std::string shellQuoted(const std::string& text) {
-  std::string out = "'";
-  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 void catchStopSignals() {
   struct sigaction sa {};
   sa.sa_handler = onStopSignal;
