@@ -32,11 +32,13 @@ namespace {
 
 // Progress of a run on stderr as whole lines (never a "\r" line that a diagnostic printed
 // during the run would run into): at every 10 % and at least every 10 s of wall time, with the
-// simulated time and the wall time left (extrapolated from the elapsed time).
+// simulated time and the wall time left: extrapolated at the pace since the last line (a run
+// whose parts pour in grows dearer as it goes), or from the start for the first line.
 Progress lineProgress(const std::string& label, double simulated_seconds) {
   using Clock = std::chrono::steady_clock;
   struct State {
     Clock::time_point start = Clock::now(), last = Clock::now();
+    double last_f = 0;
     int next_tenth = 1;
     bool done = false;
   };
@@ -55,11 +57,15 @@ Progress lineProgress(const std::string& label, double simulated_seconds) {
     const bool tenth = f * 10 >= state->next_tenth;
     if (!tenth && now - state->last < std::chrono::seconds(10)) return;
     while (state->next_tenth <= f * 10) ++state->next_tenth;
+    const double since = std::chrono::duration<double>(now - state->last).count();
+    const double left = state->last_f > 0 && f > state->last_f
+                            ? since * (1 - f) / (f - state->last_f)
+                            : elapsed * (1 - f) / f;
     state->last = now;
+    state->last_f = f;
     std::fprintf(stderr,
                  "%s: %3.0f %% (%.4g of %.4g s simulated), %.0f s elapsed, about %.0f s left\n",
-                 label.c_str(), 100 * f, f * simulated_seconds, simulated_seconds, elapsed,
-                 elapsed * (1 - f) / f);
+                 label.c_str(), 100 * f, f * simulated_seconds, simulated_seconds, elapsed, left);
     std::fflush(stderr);
   };
 }

@@ -257,11 +257,12 @@ TEST(SceneLimits, DurationOfAstronomicalStepCountIsRefused) {
           {"1e+300", "would take 1e+303 steps", "at most 1e+09 steps"});
 }
 
+// Integer settings are named in full (2000000000, not 2e+09), with their range.
 TEST(SceneLimits, IterationCountsBeyondTheirCapsAreRefused) {
   refused(replaced(kGood, R"("iterations": 50)", R"("iterations": 2e9)"), "solver.iterations",
-          {"2e+09", "[1, 1000000]"});
+          {"got 2000000000", "[1, 1000000]"});
   refused(replaced(kGood, R"("coulomb_iterations": 10)", R"("coulomb_iterations": 1e7)"),
-          "solver.coulomb_iterations", {"1e+07", "[0, 1000000]"});
+          "solver.coulomb_iterations", {"got 10000000", "[0, 1000000]"});
 }
 
 TEST(SceneLimits, SampleIntervalLongerThanTheDurationIsRefused) {
@@ -361,6 +362,11 @@ TEST(SceneLimits, InvertedSpawnRegionNamesTheAxis) {
 TEST(SceneLimits, PartCountBeyondTheGeomCapIsRefused) {
   refused(replaced(kGood, R"("count": 3)", R"("count": 100000)"), "parts[0].count",
           {"100000", "[1, 4096]"});
+  // In full, not 1e+06; and a count beyond an int is said to be too large, not "not an integer".
+  refused(replaced(kGood, R"("count": 3)", R"("count": 1000000)"), "parts[0].count",
+          {"got 1000000", "[1, 4096]"});
+  refused(replaced(kGood, R"("count": 3)", R"("count": 3000000000)"), "parts[0].count",
+          {"between -2e9 and 2e9", "3000000000"});
 }
 
 TEST(SceneLimits, PartsAndFixtureGeomsTogetherBeyondTheGeomCapAreRefused) {

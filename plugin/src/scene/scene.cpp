@@ -27,6 +27,10 @@ constexpr int kPlacementTries = 200;
   out << path << " = " << value << ": " << why;
   throw std::invalid_argument(out.str());
 }
+// An integer setting (a count) in full: 1000000, not 1e+06.
+[[noreturn]] void bad(const std::string& path, int value, const std::string& why) {
+  throw std::invalid_argument(path + " = " + std::to_string(value) + ": " + why);
+}
 
 std::string show(double v) {
   return formatNumber(v);

@@ -96,8 +96,13 @@ void read(const json& v, const std::string& path, double& out, Range range = Ran
 void read(const json& v, const std::string& path, int& out, int min) {
   double d = 0;
   read(v, path, d);
-  if (d != std::floor(d) || std::abs(d) > 2e9)
-    fail(path, "expected an integer, got " + describe(v));
+  if (d != std::floor(d)) fail(path, "expected an integer, got " + describe(v));
+  if (std::abs(d) > 2e9) {
+    fail(path,
+         "expected an integer between -2e9 and 2e9 (the setting's own range is narrower), "
+         "got " +
+             describe(v));
+  }
   if (d < min) fail(path, "must be >= " + std::to_string(min) + ", got " + describe(v));
   out = static_cast<int>(d);
 }
