@@ -373,8 +373,9 @@ Scene meshBowlFeederScene(int nuts, double rate, double duration) {
   p.count = nuts;
   p.rate = rate;
   // Dropped one by one onto the cone (at r = 90..102 mm, where its surface is 22..28 mm high)
-  // from at most 15 mm above it; a nut's corners reach 6.9 mm from its centre at the largest
-  // size.
+  // from at most 15 mm above it. A nut's corners reach 6.9 mm from its centre at the largest
+  // size, and the region's lowest inner corner is 6.6 mm from the cone: the largest nuts, turned
+  // corner down there, start up to 0.3 mm inside it and are pushed out.
   p.spawn_min = {0.0, -0.100, 0.0350};
   p.spawn_max = {0.02, -0.090, 0.0370};
   s.parts.push_back(p);

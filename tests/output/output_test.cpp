@@ -2,12 +2,14 @@
 // output.cpp: files written atomically and the feeder metrics' CSV and JSON, read back (the
 // JSON with nlohmann-json, the CSV split by hand) and compared with the metrics written.
 #include "rheofeed/output/output.hpp"
+#include "rheofeed/output/plot.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -170,6 +172,31 @@ TEST(WriteFileAtomically, AFolderThatCannotBeCreatedThrowsNamingIt) {
   }
   EXPECT_EQ(readFile(folder / "file"), "plain file");
   EXPECT_EQ(fileNames(folder), std::vector<std::string>{"file"});
+}
+
+// A plot whose file name holds a quote is written, and leaves nothing else beside it (gnuplot
+// read the name up to the quote, failed, and left a stray file named by its first part).
+TEST(PlotPng, AQuoteInTheFileNameIsWrittenAndLeavesNothingElse) {
+  const fs::path folder = freshFolder("plot_quote");
+  const fs::path path = folder / "o'k.png";
+  ASSERT_TRUE(plotPng("set datafile separator ','\nplot $d using 1:2 with lines",
+                      {{"d", "x,y\n0,0\n1,1\n"}}, path.string()));
+  EXPECT_EQ(fileNames(folder), std::vector<std::string>{"o'k.png"});
+}
+
+// Without gnuplot (not on the PATH), a plot whose data fill more than a pipe's buffer fails and
+// says so: the process is not killed by SIGPIPE, and no file is left.
+TEST(PlotPng, WithoutGnuplotALargePlotFailsWithoutKillingTheProcess) {
+  const fs::path folder = freshFolder("plot_nognuplot");
+  std::string csv = "x,y\n";
+  for (int k = 0; k < 20000; ++k) csv += std::to_string(k) + "," + std::to_string(k % 7) + "\n";
+  const char* old_path = std::getenv("PATH");
+  const std::string saved = old_path ? old_path : "";
+  ::setenv("PATH", (folder / "nothing_here").c_str(), 1);
+  const bool written = plotPng("plot $d using 1:2", {{"d", csv}}, (folder / "big.png").string());
+  ::setenv("PATH", saved.c_str(), 1);
+  EXPECT_FALSE(written);
+  EXPECT_TRUE(fileNames(folder).empty());
 }
 
 TEST(JsonQuoted, EscapesQuotesBackslashesAndControlCharacters) {

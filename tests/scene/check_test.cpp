@@ -16,8 +16,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <random>
 #include <string>
+#include <utility>
 
 #include "common/builtin_scenes.hpp"
 #include "mesh_shell.hpp"
@@ -367,7 +369,7 @@ TEST(SceneCheck, SpawnInsideAClosedMeshFixtureFires) {
   ASSERT_EQ(s.fixtures[0].geoms[0].shape.kind, Shape::Kind::Mesh);
   EXPECT_TRUE(
       ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture).empty());
-  s.parts[0].spawn_min.z = 0.020;  // below the cone's surface over r = 90..96 mm
+  s.parts[0].spawn_min.z = 0.020;  // below the cone's surface over all of r = 90..102 mm
   s.parts[0].spawn_max.z = 0.021;
   std::vector<Hazard> inside =
       ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture);
@@ -382,6 +384,27 @@ TEST(SceneCheck, SpawnInsideAClosedMeshFixtureFires) {
   // The same region moved 3 mm inwards, into the cavity: quiet.
   s.parts[0].spawn_min.x = -0.149;
   s.parts[0].spawn_max.x = -0.146;
+  EXPECT_TRUE(
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture).empty());
+  // The bowl turned 90 degrees about z and moved to (1, 2, 0) m, the region in the cone with it.
+  Fixture::Geom& bowl = s.fixtures[0].geoms[0];
+  bowl.pose = Pose::axisAngle({0, 0, 1}, kPi / 2, {1, 2, 0});
+  s.parts[0].spawn_min = bowl.pose.transform({0.0, -0.100, 0.020});
+  s.parts[0].spawn_max = bowl.pose.transform({0.02, -0.090, 0.021});
+  std::swap(s.parts[0].spawn_min.x, s.parts[0].spawn_max.x);  // x' = -y: the bounds swap
+  EXPECT_EQ(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture).size(),
+            1u);
+  // A mesh that gives its shells twice still bounds them.
+  auto twice = std::make_shared<TriangleMesh>(*bowl.shape.mesh_data);
+  twice->triangles.insert(twice->triangles.end(), bowl.shape.mesh_data->triangles.begin(),
+                          bowl.shape.mesh_data->triangles.end());
+  bowl.shape.mesh_data = twice;
+  EXPECT_EQ(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture).size(),
+            1u);
+  // An open mesh (the original less its last triangle) bounds nothing: not checked, quiet.
+  auto open = std::make_shared<TriangleMesh>(*bowl.shape.mesh_data);
+  open->triangles.resize(open->triangles.size() / 2 - 3);
+  bowl.shape.mesh_data = open;
   EXPECT_TRUE(
       ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture).empty());
 }
@@ -399,13 +422,14 @@ TEST(SceneCheck, SpawnStreamOverlapCountsTheRegionAgainstAMeshPartsWidth) {
   EXPECT_TRUE(
       ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnStreamOverlap).empty());
   const double across_corners = 0.010 / std::cos(kPi / 6);
-  const double fall = std::sqrt(2 * across_corners / kG);  // s, at the mean scale
   s.parts[0].rate = 50;
   s.parts[0].spawn_max.x = s.parts[0].spawn_min.x + 0.010;
   std::vector<Hazard> h =
       ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnStreamOverlap);
   ASSERT_EQ(h.size(), 1u);
-  EXPECT_GT(h[0].limit, 0.95 * fall);  // the scale spread reaches below the mean
+  // The largest nut the size spread draws, scale 1.1 (its max): it falls its size in 51 ms, and
+  // the 10 mm region holds one.
+  EXPECT_NEAR(h[0].limit, std::sqrt(2 * 1.1 * across_corners / kG), 1e-9);
   EXPECT_DOUBLE_EQ(h[0].value, 1.0 / 50);
   s = loadScene(dir / "bowl_feeder_mesh_fill.json");
   s.parts[0].rate = 1e9;

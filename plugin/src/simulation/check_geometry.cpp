@@ -223,17 +223,21 @@ bool closedMesh(const TriangleMesh& m) {
   }
   std::sort(edges.begin(), edges.end());
   std::sort(reversed.begin(), reversed.end());
-  return !edges.empty() && std::adjacent_find(edges.begin(), edges.end()) == edges.end() &&
-         edges == reversed;
+  // As multisets: a shell given twice, or two shells that share an edge, still bound solids.
+  return !edges.empty() && edges == reversed;
 }
 
 namespace {
 
+// Winding-number evaluations (one triangle each) a region test may spend: about 0.3 s.
+constexpr double kMaxWindingTerms = 2e7;
+
 // Whether the region [lo, hi] (world) reaches into the solid bounded by the closed mesh `m`
-// placed at `pose`: a grid of points over the region (both ends of each axis and at most 5 mm
-// apart, up to 17 per axis) by winding number, and the mesh's vertices inside the region (a
-// wall thinner than the grid's spacing that crosses the region has corners in it when the
-// region holds one of its edges). A sampling check: it can miss a thin wall that crosses the
+// placed at `pose`: the mesh's vertices inside the region (a wall thinner than the grid's spacing
+// that crosses the region has corners in it when the region holds one of its edges), then a grid
+// of points over the region by winding number (both ends of each axis and at most 5 mm apart, up
+// to 17 per axis, fewer on a mesh so large that the grid would cost more than kMaxWindingTerms,
+// down to the region's 8 corners). A sampling check: it can miss a thin wall that crosses the
 // region between samples without a vertex in it.
 bool regionInsideMesh(const Vec3& lo, const Vec3& hi, const Pose& pose, const TriangleMesh& m) {
   const auto local = [&pose](const Vec3& w) {
@@ -248,8 +252,10 @@ bool regionInsideMesh(const Vec3& lo, const Vec3& hi, const Pose& pose, const Tr
       return true;
     }
   }
-  const auto samples = [](double extent) {
-    return std::clamp(static_cast<int>(std::ceil(extent / 0.005)) + 1, 2, 17);
+  const double triangles = std::max<double>(1, static_cast<double>(m.triangles.size() / 3));
+  const int most = std::clamp(static_cast<int>(std::cbrt(kMaxWindingTerms / triangles)), 2, 17);
+  const auto samples = [most](double extent) {
+    return std::clamp(static_cast<int>(std::ceil(extent / 0.005)) + 1, 2, most);
   };
   const int n[3] = {samples(hi.x - lo.x), samples(hi.y - lo.y), samples(hi.z - lo.z)};
   const auto at = [](double a, double b, int i, int count) {

@@ -276,7 +276,9 @@ void checkSpawnStream(const CheckContext& c, std::size_t part, std::vector<Hazar
     // A part released at rest falls its own largest size s in t = sqrt(2 s / g); rate t more
     // parts appear meanwhile. The region holds at most n = prod max(1, floor(span_i / s)) of
     // them side by side; when more come (a narrow region and the next part within t, or a rate
-    // that spawns many parts within a step), they overlap.
+    // that spawns many parts within a step), some certainly overlap. Fewer can still overlap:
+    // streamed parts are placed at random, not side by side, so this is a lower bound on the
+    // trouble, not a guarantee against it.
     const PartRange r = partRange(p);
     const double s_big = r.heavy.size;
     const double clear_time = std::sqrt(2 * s_big / c.g);

@@ -95,9 +95,10 @@ bool upright(const Fixture::Geom& g, const Vec3& up);
 // mesh, 0 outside, whatever its edges and vertices.
 double windingNumber(const TriangleMesh& m, const Vec3& p);
 
-// Whether `m` is closed and consistently wound: every directed edge (a, b) of a triangle is met
-// exactly once by the reverse edge (b, a) of another, vertices at the same point counting as
-// one, so the mesh bounds a solid (or several).
+// Whether `m` is closed and consistently wound: its directed edges (a, b) and their reverses
+// (b, a) are the same multiset, vertices at the same point counting as one, so the mesh bounds a
+// solid (or several). An open mesh (a sheet) bounds none: spawn regions are not checked against
+// it.
 bool closedMesh(const TriangleMesh& m);
 
 // Whether the axis-aligned region [lo, hi] (world) reaches into a fixture geom. A closed mesh

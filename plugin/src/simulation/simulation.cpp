@@ -99,7 +99,17 @@ constexpr double kTunnelCheckFraction = 1e-3;  // of the anchor's clearance, see
 // ODE's ray against a triangle mesh (OPCODE) works in single precision: about 1e-8 m at 0.1 m
 // from the origin. With 1e-9, a mesh nut's anchor that ended 0.3 mm inside a mesh cone met the
 // cone's surface going in and, backwards, coming out 3 nm apart, and counted as passed through.
+// Far from the origin the round-off grows with the coordinates (crossingTolerance).
 constexpr double kCrossingTolerance = 1e-6;
+
+// The distance (m) below which two crossings of the segment [a, b] are one surface: at least
+// kCrossingTolerance, and 8 single-precision units of the larger coordinate (1e-5 m at 10 m).
+double crossingTolerance(const Vec3& a, const Vec3& b) {
+  const double extent = std::max(
+      {std::abs(a.x), std::abs(a.y), std::abs(a.z), std::abs(b.x), std::abs(b.y), std::abs(b.z)});
+  return std::max(kCrossingTolerance,
+                  8 * static_cast<double>(std::numeric_limits<float>::epsilon()) * extent);
+}
 // An anchor that went into a fixture and out again passed through it when the exit surface faces
 // away from the entry surface: their outward normals more than 120 degrees apart (cosine below
 // -kThroughCosine). Out through a face at a right angle to the entry is a corner cut.
@@ -502,7 +512,7 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const Vec3&
   const char* kind = "part through a fixture";
   if (!tr.inside) {
     const double backward = firstCrossing(to, from);
-    if (forward + backward < length - kCrossingTolerance) {  // in and out within the step
+    if (forward + backward < length - crossingTolerance(from, to)) {  // in and out in the step
       tr.entry_fixture = fixture;
       countLoss(i, "through_fixture", kind,
                 "passed through a fixture within one step (tunnelled; kept)",
@@ -542,7 +552,8 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const Vec3&
     dGeomID crossed = nullptr;
     const double in = firstCrossing(tr.outside_point, to, nullptr, nullptr, &crossed),
                  out = firstCrossing(to, tr.outside_point);
-    if (span > 0 && in + out < span - kCrossingTolerance && crossed != tr.entry_geom) {
+    if (span > 0 && in + out < span - crossingTolerance(tr.outside_point, to) &&
+        crossed != tr.entry_geom) {
       countLoss(i, "through_fixture", kind,
                 "passed under or through a fixture while sunk into another (kept)",
                 health_.parts_through_fixture, s);

@@ -39,9 +39,13 @@ struct Hazard {
     SpawnInsideFixture,
     /// A spawn region lies below Scene::removal_height: parts are removed as they appear.
     SpawnBelowRemoval,
-    /// Parts spawned over time (PartSpec::rate > 0) from a region too small to hold two of
-    /// them side by side, faster than a part falls clear of the one before: each part appears
-    /// inside the previous one and is pushed out at up to solver.max_correcting_velocity.
+    /// Parts spawned over time (PartSpec::rate > 0) faster than the region holds them side by
+    /// side: more appear while one falls its own largest size than fit in the region (a region
+    /// narrower than a part and the next part within that time, or a rate that spawns many
+    /// within a step), so parts appear inside each other and are pushed out at up to
+    /// solver.max_correcting_velocity. value: the interval between parts (s); limit: the fall
+    /// time over the number that fit side by side (s). A lower bound on the trouble: parts are
+    /// placed at random, and can overlap below it.
     SpawnStreamOverlap,
     /// A part shape against a fixture shape that ODE 0.16 collides poorly: capsule or cylinder
     /// parts on cylinder fixtures (libccd's general convex test, one contact point per pair, no
