@@ -72,6 +72,13 @@ struct Pose {
   }
   /// R a + position: a point from the body frame to the world frame (m).
   Vec3 transform(const Vec3& a) const { return rotate(a) + position; }
+  /// R^T (w - position): a point from the world frame to the body frame (m).
+  Vec3 inverseTransform(const Vec3& w) const {
+    const double* r = rotation;
+    const Vec3 d{w.x - position.x, w.y - position.y, w.z - position.z};
+    return {r[0] * d.x + r[3] * d.y + r[6] * d.z, r[1] * d.x + r[4] * d.y + r[7] * d.z,
+            r[2] * d.x + r[5] * d.y + r[8] * d.z};
+  }
 
   /// The rotation by `angle` (rad, right hand) about the unit axis `k` (Rodrigues), placed at
   /// `position` (m).

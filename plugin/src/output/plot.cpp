@@ -16,19 +16,18 @@
 
 namespace rheofeed::scene {
 
-std::string shellQuoted(const std::string& text) {
+namespace {
+
+// `text` in single quotes, each ' in it written as `quote`.
+std::string singleQuoted(const std::string& text, const std::string& quote) {
   std::string out = "'";
-  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  for (char c : text) out += c == '\'' ? quote : std::string(1, c);
   return out + "'";
 }
 
-namespace {
-
 // `text` as a gnuplot single-quoted string: each ' doubled.
 std::string gnuplotQuoted(const std::string& text) {
-  std::string out = "'";
-  for (char c : text) out += c == '\'' ? std::string("''") : std::string(1, c);
-  return out + "'";
+  return singleQuoted(text, "''");
 }
 
 // A new empty file in the temporary folder for gnuplot's messages; empty when none can be made.
@@ -65,6 +64,10 @@ bool writeToPipe(FILE* pipe, const std::string& text) {
 }
 
 }  // namespace
+
+std::string shellQuoted(const std::string& text) {
+  return singleQuoted(text, "'\\''");
+}
 
 bool plotPng(const std::string& script,
              const std::vector<std::pair<std::string, std::string>>& datablocks,

@@ -50,7 +50,6 @@ double minAlong(const Box3& b, const Vec3& up) {
   return -maxAlong(b, -up);
 }
 
-// Extents of a mesh's bounding box in its own frame, times `scale` (m).
 Vec3 meshBoxExtents(const TriangleMesh& mesh, double scale) {
   Box3 b;
   for (std::size_t k = 0; k + 2 < mesh.vertices.size(); k += 3) {
@@ -240,12 +239,6 @@ constexpr double kMaxWindingTerms = 2e7;
 // down to the region's 8 corners). A sampling check: it can miss a thin wall that crosses the
 // region between samples without a vertex in it.
 bool regionInsideMesh(const Vec3& lo, const Vec3& hi, const Pose& pose, const TriangleMesh& m) {
-  const auto local = [&pose](const Vec3& w) {
-    const Vec3 d = w - pose.position;
-    const double* r = pose.rotation;  // R^T d: world to the mesh's frame
-    return Vec3{r[0] * d.x + r[3] * d.y + r[6] * d.z, r[1] * d.x + r[4] * d.y + r[7] * d.z,
-                r[2] * d.x + r[5] * d.y + r[8] * d.z};
-  };
   for (std::size_t k = 0; k + 2 < m.vertices.size(); k += 3) {
     const Vec3 w = pose.transform({m.vertices[k], m.vertices[k + 1], m.vertices[k + 2]});
     if (w.x > lo.x && w.x < hi.x && w.y > lo.y && w.y < hi.y && w.z > lo.z && w.z < hi.z) {
@@ -265,7 +258,7 @@ bool regionInsideMesh(const Vec3& lo, const Vec3& hi, const Pose& pose, const Tr
     for (int j = 0; j < n[1]; ++j) {
       for (int k = 0; k < n[2]; ++k) {
         const Vec3 w{at(lo.x, hi.x, i, n[0]), at(lo.y, hi.y, j, n[1]), at(lo.z, hi.z, k, n[2])};
-        if (windingNumber(m, local(w)) > 0.5) return true;
+        if (windingNumber(m, pose.inverseTransform(w)) > 0.5) return true;
       }
     }
   }
@@ -285,14 +278,8 @@ bool regionInsideGeom(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g) {
     }
     return lowest < 0;
   }
-  if (s.kind == Shape::Kind::Mesh) {
-    if (!s.mesh_data || !closedMesh(*s.mesh_data)) return false;  // no solid: not checked
-    const Box3 b = geomBounds(g);
-    if (b.bounded && !(lo.x < b.hi.x && hi.x > b.lo.x && lo.y < b.hi.y && hi.y > b.lo.y &&
-                       lo.z < b.hi.z && hi.z > b.lo.z)) {
-      return false;
-    }
-    return regionInsideMesh(lo, hi, g.pose, *s.mesh_data);
+  if (s.kind == Shape::Kind::Mesh && (!s.mesh_data || !closedMesh(*s.mesh_data))) {
+    return false;  // no solid: not checked
   }
   if (s.kind == Shape::Kind::Sphere) {
     const Vec3 c = g.pose.position;
@@ -303,7 +290,9 @@ bool regionInsideGeom(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g) {
   const Box3 b = geomBounds(g);
   const bool aabb = lo.x < b.hi.x && hi.x > b.lo.x && lo.y < b.hi.y && hi.y > b.lo.y &&
                     lo.z < b.hi.z && hi.z > b.lo.z;
-  if (!aabb || s.kind != Shape::Kind::Box) return aabb;  // cylinder, capsule: bounding box
+  if (!aabb) return false;
+  if (s.kind == Shape::Kind::Mesh) return regionInsideMesh(lo, hi, g.pose, *s.mesh_data);
+  if (s.kind != Shape::Kind::Box) return true;  // cylinder, capsule: bounding box
   // Box: separating axes of two boxes (the region's 3, the geom's 3, their 9 cross products).
   const double* r = g.pose.rotation;
   const Vec3 ge[3] = {{r[0], r[3], r[6]}, {r[1], r[4], r[7]}, {r[2], r[5], r[8]}};

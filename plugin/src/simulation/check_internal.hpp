@@ -90,6 +90,9 @@ PartRange partRange(const PartSpec& p);
 bool planOverlap(const Fixture::Geom& a, const Fixture::Geom& b, const Vec3& up);
 // Whether a geom is a box with an edge along `up`.
 bool upright(const Fixture::Geom& g, const Vec3& up);
+// Extents of a mesh's bounding box in its own frame, times `scale` (m).
+Vec3 meshBoxExtents(const TriangleMesh& mesh, double scale);
+
 // Generalized winding number of a closed mesh at p (its frame): the solid angles of its
 // triangles seen from p (Van Oosterom and Strackee), summed, over 4 pi. 1 inside an outward
 // mesh, 0 outside, whatever its edges and vertices.

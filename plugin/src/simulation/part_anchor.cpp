@@ -86,19 +86,15 @@ void partSizes(const Shape& s, double& min_half, double& radius) {
       radius = s.radius + 0.5 * s.length;
       return;
     case Shape::Kind::Mesh: {
-      double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
       radius = 0;
       min_half = 0;
       if (!s.mesh_data || s.mesh_data->vertices.size() < 3) return;
       for (std::size_t k = 0; k + 2 < s.mesh_data->vertices.size(); k += 3) {
         const double* v = &s.mesh_data->vertices[k];
-        for (int c = 0; c < 3; ++c) {
-          lo[c] = std::min(lo[c], v[c]);
-          hi[c] = std::max(hi[c], v[c]);
-        }
         radius = std::max(radius, norm(Vec3{v[0], v[1], v[2]}));
       }
-      min_half = 0.5 * std::min({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+      const Vec3 e = checks::meshBoxExtents(*s.mesh_data, 1.0);
+      min_half = 0.5 * std::min({e.x, e.y, e.z});
       return;
     }
     case Shape::Kind::Plane:
