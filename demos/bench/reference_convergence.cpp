@@ -11,7 +11,8 @@
 // Outputs: --csv FILE (one row per step with contacts), and the summary on stdout (markdown).
 //
 // Usage: reference_convergence [--scene NAME|FILE] [--duration S] [--solver nsgs|fixed_point]
-//          [--groups] [--sweeps N] [--global-newton N] [--omega W] [--proximal P] [--csv FILE]
+//          [--groups] [--sweeps N] [--global-newton N] [--omega W] [--proximal P]
+//          [--ipm-max-contacts N] [--newton-max-contacts N] [--csv FILE]
 
 #include <CLI/CLI.hpp>
 
@@ -72,6 +73,7 @@ int main(int argc, char** argv) {
   std::string solver = "nsgs";
   bool groups = false;
   int sweeps = 0, global_newton = -1, newton_iterations = 0, ipm_rounds = -1, ipm_outer = 0;
+  int ipm_max_contacts = -1, newton_max_contacts = -1;
   double omega = 1.0, proximal = 0.0, step_limit = 0.0;
   std::string csv_path, dump_dir;
   app.add_option("--scene", scene_name, "scene name in demos/scenes or a scene file");
@@ -99,6 +101,12 @@ int main(int argc, char** argv) {
   app.add_option("--ipm-outer", ipm_outer,
                  "fixed-point iterations of that second solve (0: the world's default)")
       ->check(CLI::Range(0, 10000));
+  app.add_option("--ipm-max-contacts", ipm_max_contacts,
+                 "largest problem the interior-point rounds take (-1: the world's default)")
+      ->check(CLI::Range(-1, 100000000));
+  app.add_option("--newton-max-contacts", newton_max_contacts,
+                 "NSGS: largest problem given global Newton steps (-1: the world's default)")
+      ->check(CLI::Range(-1, 100000000));
   app.add_option("--csv", csv_path, "per-step CSV output");
   app.add_option("--dump", dump_dir,
                  "write the contact problem of every unconverged step here (fc3d, <time>.dat)");
@@ -117,8 +125,22 @@ int main(int argc, char** argv) {
     scene.outputs.warmup = 0;
     const double tolerance = scene.solver.tolerance;
     std::vector<StepRecord> steps;
+    // Progress on stderr every kProgressInterval of wall-clock time.
+    constexpr double kProgressInterval = 30.0;  // s
+    const auto started = std::chrono::steady_clock::now();
+    double next_progress = kProgressInterval;
+    int converged_so_far = 0;
     auto observer = [&](const reference::World& world, const reference::StepReport& report) {
+      const double wall =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      if (wall >= next_progress) {
+        next_progress = wall + kProgressInterval;
+        std::fprintf(stderr,
+                     "progress: t = %.3f of %g s, %zu steps with contacts, %d converged, %.0f s\n",
+                     world.time(), duration, steps.size(), converged_so_far, wall);
+      }
       if (report.contacts == 0) return;
+      if (report.solve.status == ccp::Status::Converged) ++converged_so_far;
       steps.push_back({world.time(), report.contacts, report.solve.status, report.solve.iterations,
                        report.coulomb_residual, report.solve.solve_time_s,
                        report.solve.local_fallbacks, report.coulomb_fallback,
@@ -145,6 +167,8 @@ int main(int argc, char** argv) {
       if (step_limit > 0) s.nsgs.global_newton_step_limit = step_limit;
       if (ipm_rounds >= 0) s.ipm_rounds = ipm_rounds;
       if (ipm_outer > 0) s.ipm.max_outer_iterations = ipm_outer;
+      if (ipm_max_contacts >= 0) s.ipm_max_contacts = ipm_max_contacts;
+      if (newton_max_contacts >= 0) s.nsgs.global_newton_max_contacts = newton_max_contacts;
     };
     const double cpu_start = cpuSeconds();
     auto sim = rheofeed::scene::makeObservedReferenceSimulation(

@@ -15,12 +15,14 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <regex>
 #include <string>
 #include <vector>
 
 #include "rheofeed/output/output.hpp"
+#include "rheofeed/scene/scene_io.hpp"
 #include "stability/stability_cases.hpp"
 
 namespace {
@@ -50,12 +52,41 @@ void drain(Child& c) {
   close(c.fd);
 }
 
+// Writes every case matching `re` (and `quick`) as `<dir>/<case>.json`; 0 when at least one was
+// written, 2 (with the reason on stderr) otherwise.
+int writeScenes(const std::vector<StabilityCase>& all, const std::regex& re, bool quick,
+                const std::string& dir) {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) {
+    std::fprintf(stderr, "--write-scenes '%s': cannot create the folder: %s\n", dir.c_str(),
+                 error.message().c_str());
+    return 2;
+  }
+  int written = 0;
+  for (const StabilityCase& c : all) {
+    if ((quick && !c.quick) || !std::regex_search(c.name, re)) continue;
+    const std::string path = dir + "/" + c.name + ".json";
+    try {
+      scene::writeFileAtomically(path, scene::toJson(c.scene));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "--write-scenes: %s\n", e.what());
+      return 2;
+    }
+    std::printf("%s\n", path.c_str());
+    ++written;
+  }
+  if (written == 0) std::fprintf(stderr, "no case matches\n");
+  return written > 0 ? 0 : 2;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Stability matrix: stiff and extreme cases through every method (issue 7)"};
   std::string out = "out/stability";
   std::string filter;
+  std::string scenes_dir;
   bool quick = false, list = false;
   int jobs = 1;
   app.add_option("--out", out, "output folder for stability.csv and stability.md")
@@ -63,6 +94,9 @@ int main(int argc, char** argv) {
   app.add_option("--filter", filter, "run only the cases whose name matches this regex (search)");
   app.add_flag("--quick", quick, "only the cases that run in seconds (the ctest reduced matrix)");
   app.add_flag("--list", list, "list the cases and their methods, run nothing");
+  app.add_option("--write-scenes", scenes_dir,
+                 "write the matching cases as scene files (<case>.json) to this folder, for "
+                 "`rheofeed run`, and run nothing");
   app.add_option("--jobs", jobs, "runs in parallel (forked processes)")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
@@ -92,6 +126,7 @@ int main(int argc, char** argv) {
     std::printf("%zu cases of %zu, %zu runs\n", matched, all.size(), runs.size());
     return 0;
   }
+  if (!scenes_dir.empty()) return writeScenes(all, re, quick, scenes_dir);
   if (runs.empty()) {
     std::fprintf(stderr, "no case matches\n");
     return 2;

@@ -47,6 +47,36 @@ struct Box {
   Problem dense, matrix_free;
 };
 
+// Completes `box` from its contact directions box.d (6 nb x 3 nc), the bodies' diagonal inverse
+// masses and free velocities: the dense problem with the compliance kCompliance on N's diagonal,
+// and the matrix-free one as the reference world builds it, N + c I = [D; sqrt(c) I]^T
+// blkdiag(M^-1, I) [D; sqrt(c) I]. Every contact has mu = kMu.
+void finish(Box& box, const Eigen::VectorXd& inverse_mass, const Eigen::VectorXd& v_free) {
+  const Eigen::Index dofs = box.d.rows(), n = box.d.cols();
+  box.minv = inverse_mass.asDiagonal();
+  box.v_free = v_free;
+  const Eigen::VectorXd r = box.d.transpose() * v_free;
+  const Eigen::VectorXd mu = Eigen::VectorXd::Constant(n / 3, kMu);
+  Eigen::MatrixXd delassus = box.d.transpose() * box.minv * box.d;
+  delassus.diagonal().array() += kCompliance;
+  box.dense = Problem::makeDense(delassus, r, mu);
+  std::vector<Eigen::Triplet<double>> d_entries, m_entries;
+  for (Eigen::Index row = 0; row < dofs; ++row) {
+    for (Eigen::Index col = 0; col < n; ++col) {
+      if (box.d(row, col) != 0.0) d_entries.emplace_back(row, col, box.d(row, col));
+    }
+    m_entries.emplace_back(row, row, inverse_mass[row]);
+  }
+  for (Eigen::Index k = 0; k < n; ++k) {
+    d_entries.emplace_back(dofs + k, k, std::sqrt(kCompliance));
+    m_entries.emplace_back(dofs + k, dofs + k, 1.0);
+  }
+  SparseMatrix d_aug(dofs + n, n), minv_aug(dofs + n, dofs + n);
+  d_aug.setFromTriplets(d_entries.begin(), d_entries.end());
+  minv_aug.setFromTriplets(m_entries.begin(), m_entries.end());
+  box.matrix_free = Problem::makeMatrixFree(d_aug, minv_aug, r, mu);
+}
+
 // A box resting on a plane inclined by theta, frame x down the slope, y across, z out of the
 // plane (each contact's n = z, t1 = x, t2 = y); at rest at the start of the step.
 Box boxOnIncline(double theta) {
@@ -69,32 +99,65 @@ Box boxOnIncline(double theta) {
   Eigen::VectorXd inverse_mass(6);
   inverse_mass << 1 / kMass, 1 / kMass, 1 / kMass, 3 / (kMass * (kHalfY * kHalfY + hz * hz)),
       3 / (kMass * (kHalfX * kHalfX + hz * hz)), 3 / (kMass * (kHalfX * kHalfX + kHalfY * kHalfY));
-  box.minv = inverse_mass.asDiagonal();
-  box.v_free = Eigen::VectorXd::Zero(6);
-  box.v_free.head<3>() = kStep * kGravity * Eigen::Vector3d(std::sin(theta), 0, -std::cos(theta));
-  const Eigen::VectorXd r = box.d.transpose() * box.v_free;
-  const Eigen::VectorXd mu = Eigen::VectorXd::Constant(4, kMu);
-  Eigen::MatrixXd n = box.d.transpose() * box.minv * box.d;
-  n.diagonal().array() += kCompliance;
-  box.dense = Problem::makeDense(n, r, mu);
-  // Matrix-free as the reference world builds it: N + c I = [D; sqrt(c) I]^T blkdiag(M^-1, I)
-  // [D; sqrt(c) I].
-  std::vector<Eigen::Triplet<double>> d_entries, m_entries;
-  for (int row = 0; row < 6; ++row) {
-    for (int col = 0; col < 12; ++col) {
-      if (box.d(row, col) != 0.0) d_entries.emplace_back(row, col, box.d(row, col));
-    }
-    m_entries.emplace_back(row, row, inverse_mass[row]);
-  }
-  for (int k = 0; k < 12; ++k) {
-    d_entries.emplace_back(6 + k, k, std::sqrt(kCompliance));
-    m_entries.emplace_back(6 + k, 6 + k, 1.0);
-  }
-  SparseMatrix d_aug(18, 12), minv_aug(18, 18);
-  d_aug.setFromTriplets(d_entries.begin(), d_entries.end());
-  minv_aug.setFromTriplets(m_entries.begin(), m_entries.end());
-  box.matrix_free = Problem::makeMatrixFree(d_aug, minv_aug, r, mu);
+  Eigen::VectorXd v_free = Eigen::VectorXd::Zero(6);
+  v_free.head<3>() = kStep * kGravity * Eigen::Vector3d(std::sin(theta), 0, -std::cos(theta));
+  finish(box, inverse_mass, v_free);
   return box;
+}
+
+// Fills the 6 x 3 block of d for contact `contact` acting on a body at the lever arm `arm` (from
+// the body's centre, m) along the contact frame (n = z, t1 = x, t2 = y), with sign `sign`.
+void addContact(Eigen::MatrixXd& d, int body, int contact, const Eigen::Vector3d& arm,
+                double sign) {
+  const Eigen::Vector3d axes[3] = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX(),
+                                   Eigen::Vector3d::UnitY()};
+  for (int k = 0; k < 3; ++k) {
+    d.block<3, 1>(6 * body, 3 * contact + k) += sign * axes[k];
+    d.block<3, 1>(6 * body + 3, 3 * contact + k) += sign * arm.cross(axes[k]);
+  }
+}
+
+// A second box, half the mass, 0.6 times as long and wide, resting on the first box of
+// boxOnIncline 2 mm off centre down the slope: 8 corner contacts, 4 of them between the two
+// bodies (each pushes the upper box along its normal and the lower one back), so N couples the
+// bodies, and the upper box's offset loads the lower box's corners unevenly.
+Box stackOnIncline(double theta) {
+  constexpr double kTopMass = 0.5 * kMass, kTopScale = 0.6, kOffset = 0.002;
+  const double hx = kTopScale * kHalfX, hy = kTopScale * kHalfY, hz = kHeight;
+  Box box;
+  box.d = Eigen::MatrixXd::Zero(12, 24);
+  int i = 0;
+  for (const double sx : {-1.0, 1.0}) {
+    for (const double sy : {-1.0, 1.0}) {
+      addContact(box.d, 0, i, {sx * kHalfX, sy * kHalfY, -kHeight}, 1.0);  // on the plane
+      addContact(box.d, 1, 4 + i, {sx * hx, sy * hy, -hz}, 1.0);           // upper box
+      addContact(box.d, 0, 4 + i, {kOffset + sx * hx, sy * hy, kHeight}, -1.0);
+      ++i;
+    }
+  }
+  Eigen::VectorXd inverse_mass(12);
+  inverse_mass << 1 / kMass, 1 / kMass, 1 / kMass,
+      3 / (kMass * (kHalfY * kHalfY + kHeight * kHeight)),
+      3 / (kMass * (kHalfX * kHalfX + kHeight * kHeight)),
+      3 / (kMass * (kHalfX * kHalfX + kHalfY * kHalfY)), 1 / kTopMass, 1 / kTopMass, 1 / kTopMass,
+      3 / (kTopMass * (hy * hy + hz * hz)), 3 / (kTopMass * (hx * hx + hz * hz)),
+      3 / (kTopMass * (hx * hx + hy * hy));
+  Eigen::VectorXd v_free = Eigen::VectorXd::Zero(12);
+  const Eigen::Vector3d fall =
+      kStep * kGravity * Eigen::Vector3d(std::sin(theta), 0, -std::cos(theta));
+  v_free.segment<3>(0) = fall;
+  v_free.segment<3>(6) = fall;
+  finish(box, inverse_mass, v_free);
+  return box;
+}
+
+// The sticking solution of a problem built by finish(), from the rigid bodies: u = N gamma + r = 0
+// gives gamma = D^T lambda with (D D^T + c M) lambda = -M v_free (then N gamma + r =
+// D^T (M^-1 (D D^T + c M) lambda + v_free) = 0).
+Eigen::VectorXd compliantStaticSolution(const Box& box) {
+  const Eigen::MatrixXd mass = box.minv.inverse();
+  const Eigen::MatrixXd system = box.d * box.d.transpose() + kCompliance * mass;
+  return box.d.transpose() * system.ldlt().solve(-mass * box.v_free);
 }
 
 class GlobalNewtonBox : public testing::TestWithParam<bool> {
@@ -110,22 +173,19 @@ class GlobalNewtonBox : public testing::TestWithParam<bool> {
     NsgsSolver solver(settings);
     return solver.solve(problem(box), gamma);
   }
+  void expectCompliantStaticSplit(const Box& box) const;
 };
 
 // Sweeps between global Newton steps: NsgsSettings' default.
 const int kGlobalNewtonInterval = NsgsSettings{}.global_newton_interval;
 
-TEST_P(GlobalNewtonBox, CornersOnAnInclineTakeTheCompliantStaticSplit) {
-  const Box box = boxOnIncline(0.5 * std::atan(kMu));
-  // Closed form of the sticking solution, from the rigid body: u = N gamma + r = 0 gives
-  // gamma = D^T lambda with (D D^T + c M) lambda = -M v_free (then N gamma + r =
-  // D^T (M^-1 (D D^T + c M) lambda + v_free) = 0).
-  const Eigen::MatrixXd mass = box.minv.inverse();
-  const Eigen::MatrixXd system = box.d * box.d.transpose() + kCompliance * mass;
-  const Eigen::VectorXd lambda = system.ldlt().solve(-mass * box.v_free);
-  const Eigen::VectorXd exact = box.d.transpose() * lambda;
-  for (int i = 0; i < 4; ++i) {  // the closed form sticks: every corner inside its cone
-    ASSERT_LT(exact.segment<2>(3 * i + 1).norm(), kMu * exact[3 * i]);
+// The problem's closed-form sticking solution (every contact pressed and inside its cone) is
+// reached with the default global Newton steps, and within kImpulseAgreement.
+void GlobalNewtonBox::expectCompliantStaticSplit(const Box& box) const {
+  const Eigen::VectorXd exact = compliantStaticSolution(box);
+  for (Eigen::Index i = 0; i < exact.size() / 3; ++i) {
+    ASSERT_GT(exact[3 * i], 0.0) << "contact " << i;
+    ASSERT_LT(exact.segment<2>(3 * i + 1).norm(), kMu * exact[3 * i]) << "contact " << i;
   }
   Eigen::VectorXd gamma;
   const Result result = solveBox(box, kGlobalNewtonInterval, gamma);
@@ -133,10 +193,41 @@ TEST_P(GlobalNewtonBox, CornersOnAnInclineTakeTheCompliantStaticSplit) {
       << result.iterations << " sweeps, residual " << result.residual;
   EXPECT_GE(result.global_newton_kept, 1);
   EXPECT_LE((gamma - exact).norm(), kImpulseAgreement * exact.norm());
+}
+
+TEST_P(GlobalNewtonBox, CornersOnAnInclineTakeTheCompliantStaticSplit) {
+  const Box box = boxOnIncline(0.5 * std::atan(kMu));
+  expectCompliantStaticSplit(box);
 
   // Sweeps alone, with the same budget, do not get there (the reason for the global steps).
   Eigen::VectorXd gamma_sweeps;
   EXPECT_EQ(solveBox(box, 0, gamma_sweeps).status, Status::MaxIterations);
+}
+
+TEST_P(GlobalNewtonBox, AStackOfTwoBoxesOnAnInclineTakesTheCompliantStaticSplit) {
+  const Box stack = stackOnIncline(0.5 * std::atan(kMu));
+  // The offset upper box loads the lower box's corners unevenly (else this is the one-box case).
+  const Eigen::VectorXd exact = compliantStaticSolution(stack);
+  ASSERT_GT(exact[3 * 6] - exact[3 * 4], 0.05 * exact[3 * 4]);
+  expectCompliantStaticSplit(stack);
+}
+
+TEST(GlobalNewton, MatrixFreeStepsAreTheDenseFormsOnATwoBodyStack) {
+  // The matrix-free form solves its Newton systems augmented with M^-1 D (global_newton.cpp),
+  // the dense form with N itself: the same steps, so the same sweeps and impulses to round-off.
+  const Box stack = stackOnIncline(0.5 * std::atan(kMu));
+  NsgsSettings settings;
+  settings.tolerance = kTolerance;
+  settings.max_iterations = kBoxSweeps;
+  NsgsSolver solver(settings);
+  Eigen::VectorXd dense_gamma, free_gamma;
+  const Result dense = solver.solve(stack.dense, dense_gamma);
+  const Result matrix_free = solver.solve(stack.matrix_free, free_gamma);
+  ASSERT_GE(dense.global_newton_kept, 1);
+  EXPECT_EQ(matrix_free.iterations, dense.iterations);
+  EXPECT_EQ(matrix_free.global_newton_tries, dense.global_newton_tries);
+  EXPECT_EQ(matrix_free.global_newton_kept, dense.global_newton_kept);
+  EXPECT_LE((free_gamma - dense_gamma).norm(), 1e-9 * dense_gamma.norm());
 }
 
 TEST_P(GlobalNewtonBox, ABoxSlidingDownAnInclineHasTheExactAcceleration) {

@@ -14,8 +14,13 @@
 //     inside the disk (||b|| <= R): B_t = 0,  A_t = rho_t [0 I]
 //     outside:  B_t = [-mu [a > 0] bhat,  I - (R/||b||) T],  A_t = [mu [a > 0] rho_n bhat,
 //               (R/||b||) rho_t T],  bhat = b / ||b||, T = I - bhat bhat^T.
-// With du = N dg the Newton system is (B + A N) d = -Phi: sparse with N's block pattern,
-// non-symmetric, and solved by Eigen's SparseLU (COLAMD ordering). Every contact is solved with
+// With du = N dg the Newton system is (B + A N) d = -Phi, non-symmetric, solved by Eigen's
+// SparseLU (COLAMD ordering). For a matrix-free problem, N = D^T M^-1 D is not formed: N couples
+// every two contacts on one body (a part in a pile touches a dozen), and its factors fill in
+// with the pile. The system is solved augmented instead, with w = M^-1 D d:
+//     [ B          A D^T ] [d]   [-Phi]
+//     [ -M^-1 D    I     ] [w] = [ 0  ]
+// whose pattern is D's (each contact row touches its two bodies). Every contact is solved with
 // all the others at once, so the impulses of coplanar contacts (a box's four corners, rank
 // deficient up to the compliance) and of statically indeterminate piles are distributed in one
 // step, where Gauss-Seidel moves them only at the compliance's pace. Globalisation: a step
@@ -86,11 +91,11 @@ void alartCurnier(const Problem& problem, const GlobalNewtonWorkspace& ws, const
 void GlobalNewtonWorkspace::prepare(const Problem& problem) {
   if (problem.form == DelassusForm::Dense) {
     n = problem.delassus.sparseView();
+    n.makeCompressed();
   } else {
-    const SparseMatrix minv_d = problem.minv * problem.d;
-    n = SparseMatrix(problem.d.transpose()) * minv_d;
+    minv_d = problem.minv * problem.d;
+    minv_d.makeCompressed();
   }
-  n.makeCompressed();
   const Eigen::Index nc = problem.numContacts();
   rho_n.resize(nc);
   rho_t.resize(nc);
@@ -105,6 +110,15 @@ void GlobalNewtonWorkspace::prepare(const Problem& problem) {
   prepared = true;
 }
 
+void GlobalNewtonWorkspace::multiplyN(const Problem& problem, const Eigen::VectorXd& g,
+                                      Eigen::VectorXd& out) const {
+  if (problem.form == DelassusForm::Dense) {
+    out.noalias() = n * g;
+  } else {
+    out.noalias() = problem.d.transpose() * (minv_d * g);
+  }
+}
+
 double globalNewton(const Problem& problem, const Eigen::VectorXd& gamma, int iterations,
                     double step_limit, double tolerance, double rho, const Deadline& deadline,
                     GlobalNewtonWorkspace& ws, Workspace& base, Eigen::VectorXd& candidate) {
@@ -114,9 +128,13 @@ double globalNewton(const Problem& problem, const Eigen::VectorXd& gamma, int it
   std::vector<Eigen::Matrix3d> a_blocks(static_cast<std::size_t>(nc));
   std::vector<Eigen::Matrix3d> b_blocks(static_cast<std::size_t>(nc));
   std::vector<Eigen::Triplet<double>> entries;
+  const bool augmented = problem.form == DelassusForm::MatrixFree;
+  const Eigen::Index m = augmented ? problem.numDofs() : 0;
   Eigen::VectorXd g = gamma;
-  Eigen::VectorXd u = ws.n * g + problem.r;
-  Eigen::VectorXd phi, trial_u, direction, n_direction;
+  Eigen::VectorXd u;
+  ws.multiplyN(problem, g, u);
+  u += problem.r;
+  Eigen::VectorXd phi, trial_u, direction, n_direction, rhs, solution;
   Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> lu;
   const double start = relativeResidual(gamma, u, problem.r, problem.mu, rho, true, base);
   double best = start;
@@ -125,7 +143,9 @@ double globalNewton(const Problem& problem, const Eigen::VectorXd& gamma, int it
     alartCurnier(problem, ws, g, u, phi, &a_blocks, &b_blocks);
     if (phi.squaredNorm() == 0.0) break;
     entries.clear();
-    entries.reserve(static_cast<std::size_t>(3 * ws.n.nonZeros() + 9 * nc));
+    entries.reserve(static_cast<std::size_t>(augmented ? 4 * problem.d.nonZeros() +
+                                                             ws.minv_d.nonZeros() + m + 9 * nc
+                                                       : 3 * ws.n.nonZeros() + 9 * nc));
     for (Eigen::Index i = 0; i < nc; ++i) {
       const Eigen::Matrix3d& bm = b_blocks[static_cast<std::size_t>(i)];
       for (int p = 0; p < 3; ++p) {
@@ -137,27 +157,53 @@ double globalNewton(const Problem& problem, const Eigen::VectorXd& gamma, int it
         }
       }
     }
-    for (Eigen::Index col = 0; col < n; ++col) {
-      for (SparseMatrix::InnerIterator it(ws.n, col); it; ++it) {
-        const Eigen::Index i = it.row() / 3;
-        const int m = static_cast<int>(it.row() % 3);
+    if (augmented) {
+      // Rows of contact i: A_i D_i^T w, with w = M^-1 D d the unknowns after d.
+      for (Eigen::Index col = 0; col < n; ++col) {
+        const Eigen::Index i = col / 3;
+        const int axis = static_cast<int>(col % 3);
         const Eigen::Matrix3d& am = a_blocks[static_cast<std::size_t>(i)];
-        for (int p = 0; p < 3; ++p) {
-          if (am(p, m) != 0.0) {
-            entries.emplace_back(static_cast<int>(3 * i + p), static_cast<int>(col),
-                                 am(p, m) * it.value());
+        for (SparseMatrix::InnerIterator it(problem.d, col); it; ++it) {
+          for (int p = 0; p < 3; ++p) {
+            if (am(p, axis) != 0.0) {
+              entries.emplace_back(static_cast<int>(3 * i + p), static_cast<int>(n + it.row()),
+                                   am(p, axis) * it.value());
+            }
+          }
+        }
+        for (SparseMatrix::InnerIterator it(ws.minv_d, col); it; ++it) {
+          entries.emplace_back(static_cast<int>(n + it.row()), static_cast<int>(col), -it.value());
+        }
+      }
+      for (Eigen::Index row = 0; row < m; ++row) {
+        entries.emplace_back(static_cast<int>(n + row), static_cast<int>(n + row), 1.0);
+      }
+    } else {
+      for (Eigen::Index col = 0; col < n; ++col) {
+        for (SparseMatrix::InnerIterator it(ws.n, col); it; ++it) {
+          const Eigen::Index i = it.row() / 3;
+          const int axis = static_cast<int>(it.row() % 3);
+          const Eigen::Matrix3d& am = a_blocks[static_cast<std::size_t>(i)];
+          for (int p = 0; p < 3; ++p) {
+            if (am(p, axis) != 0.0) {
+              entries.emplace_back(static_cast<int>(3 * i + p), static_cast<int>(col),
+                                   am(p, axis) * it.value());
+            }
           }
         }
       }
     }
-    SparseMatrix jacobian(n, n);
+    SparseMatrix jacobian(n + m, n + m);
     jacobian.setFromTriplets(entries.begin(), entries.end());
     jacobian.makeCompressed();
     lu.compute(jacobian);
     if (lu.info() != Eigen::Success) break;
-    direction = lu.solve(-phi);
-    if (lu.info() != Eigen::Success || !direction.allFinite()) break;
-    n_direction = ws.n * direction;
+    rhs.setZero(n + m);
+    rhs.head(n) = -phi;
+    solution = lu.solve(rhs);
+    if (lu.info() != Eigen::Success || !solution.allFinite()) break;
+    direction = solution.head(n);
+    ws.multiplyN(problem, direction, n_direction);
     // The step is limited to step_limit times the largest impulse: near a solution the
     // Jacobian's null-space directions (coplanar corners, up to the compliance) can ask for
     // internal impulses far beyond the cones; a limited step crosses the kinks of Phi gradually.
@@ -175,7 +221,8 @@ double globalNewton(const Problem& problem, const Eigen::VectorXd& gamma, int it
     for (Eigen::Index i = 0; i < nc; ++i) {
       projected.segment<3>(3 * i) = projectOntoCone(g.segment<3>(3 * i), problem.mu[i]);
     }
-    trial_u = ws.n * projected + problem.r;
+    ws.multiplyN(problem, projected, trial_u);
+    trial_u += problem.r;
     const double residual =
         relativeResidual(projected, trial_u, problem.r, problem.mu, rho, true, base);
     if (residual < best) {

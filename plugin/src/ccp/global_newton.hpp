@@ -14,18 +14,25 @@ namespace rheofeed::ccp::detail {
 
 /// Reusable storage of globalNewton().
 struct GlobalNewtonWorkspace {
-  /// The Delassus matrix N as a sparse matrix (1/kg), built by prepare().
+  /// Dense problems: the Delassus matrix N as a sparse matrix (1/kg), built by prepare().
   SparseMatrix n;
+  /// Matrix-free problems: M^-1 D (ndof x 3 nc), built by prepare(); N is never formed (its
+  /// pattern couples every pair of contacts on one body and fills in under factorisation).
+  SparseMatrix minv_d;
   /// Alart-Curnier parameters of each contact (kg): 1 / W_nn and 1 / lambda_max(W_tt).
   Eigen::VectorXd rho_n, rho_t;
   bool prepared = false;
-  /// Builds `n` and the parameters from the problem (once per solve).
+  /// Builds `n` or `minv_d` and the parameters from the problem (once per solve).
   void prepare(const Problem& problem);
+  /// out = N g (3 nc, m/s) for impulses g (3 nc, N s), after prepare().
+  void multiplyN(const Problem& problem, const Eigen::VectorXd& g, Eigen::VectorXd& out) const;
 };
 
 /// Up to `iterations` semismooth Newton steps on the Alart-Curnier function of all contacts at
 /// once, from `gamma` (3 nc, N s): each step solves the sparse linear system of the generalised
-/// Jacobian J = B + A N by a sparse LU factorisation; its length is limited to `step_limit`
+/// Jacobian J = B + A N by a sparse LU factorisation (matrix-free problems: of the augmented
+/// system [B, A D^T; -M^-1 D, I] in (d gamma, M^-1 D d gamma), whose pattern is that of D rather
+/// than N's); its length is limited to `step_limit`
 /// (dimensionless, > 0) times the largest impulse of the iterate. Each iterate is projected
 /// onto the cones and judged by its Coulomb residual (relativeResidual with `rho`, using
 /// `base`'s contact scales); the steps stop early once one is at or below `tolerance`, or when
