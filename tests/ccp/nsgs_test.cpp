@@ -87,6 +87,27 @@ TEST_P(NsgsIncline, SlidesAboveTheFrictionAngleWithTheExactAcceleration) {
 
 INSTANTIATE_TEST_SUITE_P(DenseAndMatrixFree, NsgsIncline, testing::Bool(), test::formName);
 
+TEST(Nsgs, ABowlStepConvergesWithTheGlobalNewtonSteps) {
+  // tests/data/bowl_steps: a global Newton candidate that only undid the sweeps' climb led the
+  // sweeps back to the same point at every attempt (1.33e-6 after 700,000 sweeps); such a
+  // candidate now doubles the wait before the next attempt. Measured: 99,639 sweeps to 1e-6;
+  // the budget is twice that.
+  const Problem problem =
+      readFc3dFile(std::string(RHEOFEED_FC3D_DIR) + "/../bowl_steps/bowl_feeder_step_1.5s.dat");
+  constexpr double kBowlTolerance = 1e-6;  // the scene's Coulomb tolerance
+  NsgsSettings settings;
+  settings.tolerance = kBowlTolerance;
+  settings.max_iterations = 200000;
+  NsgsSolver solver(settings);
+  Eigen::VectorXd gamma;
+  const Result result = solver.solve(problem, gamma);
+  EXPECT_EQ(result.status, Status::Converged)
+      << result.iterations << " sweeps, residual " << result.residual << " " << result.message;
+  EXPECT_GE(result.global_newton_kept, 1);
+  EXPECT_LE(test::relativeResidual(problem.delassus, gamma, problem.r, problem.mu, true),
+            kBowlTolerance);
+}
+
 TEST(Nsgs, WarmStartFromTheSolutionOfARepeatedProblemTakesFewerSweeps) {
   const Problem problem = readFc3dFile(std::string(RHEOFEED_FC3D_DIR) + "/Capsules-i101-404.dat");
   NsgsSettings settings;

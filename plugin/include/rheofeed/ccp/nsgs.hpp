@@ -19,10 +19,12 @@
 /// problems are swept through the generalised velocity `M^-1 D gamma`, touching only the
 /// columns of the contact's bodies, so thousands of contacts cost O(nnz(D)) per sweep.
 /// Every NsgsSettings::global_newton_interval sweeps, semismooth Newton steps on all contacts at
-/// once (global_newton.cpp, a sparse LU factorisation) redistribute impulses along the nearly
-/// singular directions of N (a box's coplanar corners, rank deficient up to the compliance),
-/// which the sweeps correct only at the compliance's pace; they are kept only when they lower the
-/// Coulomb residual.
+/// once (global_newton.cpp, a sparse LU factorisation; of an augmented system in (d gamma,
+/// M^-1 D d gamma) for matrix-free problems, so that N is never formed) redistribute impulses
+/// along the nearly singular directions of N (a box's coplanar corners, rank deficient up to the
+/// compliance), which the sweeps correct only at the compliance's pace; they are kept only when
+/// they lower the Coulomb residual, and the wait before the next attempt doubles when they do not
+/// lower the lowest residual of the solve so far.
 ///
 /// Stopping test: the Coulomb residual of solver.hpp (Result::coulomb_distance: dimensionless
 /// natural map with De Saxce's velocity, invariant to the units of N and r), recomputed from
