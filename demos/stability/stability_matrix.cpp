@@ -53,9 +53,17 @@ void drain(Child& c) {
 }
 
 // Writes every case matching `re` (and `quick`) as `<dir>/<case>.json`; 0 when at least one was
-// written, 2 (with the reason on stderr) otherwise.
+// written, 2 (with the reason on stderr, and no folder made) otherwise.
 int writeScenes(const std::vector<StabilityCase>& all, const std::regex& re, bool quick,
                 const std::string& dir) {
+  std::vector<const StabilityCase*> matching;
+  for (const StabilityCase& c : all) {
+    if ((!quick || c.quick) && std::regex_search(c.name, re)) matching.push_back(&c);
+  }
+  if (matching.empty()) {
+    std::fprintf(stderr, "no case matches\n");
+    return 2;
+  }
   std::error_code error;
   std::filesystem::create_directories(dir, error);
   if (error) {
@@ -63,21 +71,17 @@ int writeScenes(const std::vector<StabilityCase>& all, const std::regex& re, boo
                  error.message().c_str());
     return 2;
   }
-  int written = 0;
-  for (const StabilityCase& c : all) {
-    if ((quick && !c.quick) || !std::regex_search(c.name, re)) continue;
-    const std::string path = dir + "/" + c.name + ".json";
+  for (const StabilityCase* c : matching) {
+    const std::string path = dir + "/" + c->name + ".json";
     try {
-      scene::writeFileAtomically(path, scene::toJson(c.scene));
+      scene::writeFileAtomically(path, scene::toJson(c->scene));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "--write-scenes: %s\n", e.what());
       return 2;
     }
     std::printf("%s\n", path.c_str());
-    ++written;
   }
-  if (written == 0) std::fprintf(stderr, "no case matches\n");
-  return written > 0 ? 0 : 2;
+  return 0;
 }
 
 }  // namespace

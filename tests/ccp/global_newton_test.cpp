@@ -206,9 +206,11 @@ TEST_P(GlobalNewtonBox, CornersOnAnInclineTakeTheCompliantStaticSplit) {
 
 TEST_P(GlobalNewtonBox, AStackOfTwoBoxesOnAnInclineTakesTheCompliantStaticSplit) {
   const Box stack = stackOnIncline(0.5 * std::atan(kMu));
-  // The offset upper box loads the lower box's corners unevenly (else this is the one-box case).
+  // The upper box's offset down the slope loads the lower box's downhill floor corner (2) more
+  // than its uphill one (0): by 49 % of the uphill load, where the slope alone gives 30 % (the
+  // same stack without the offset, and the one box), so the upper box's placement matters.
   const Eigen::VectorXd exact = compliantStaticSolution(stack);
-  ASSERT_GT(exact[3 * 6] - exact[3 * 4], 0.05 * exact[3 * 4]);
+  ASSERT_GT(exact[3 * 2] - exact[3 * 0], 0.4 * exact[3 * 0]);
   expectCompliantStaticSplit(stack);
 }
 

@@ -109,7 +109,7 @@ struct NsgsSolver::Workspace {
   // Groups of contacts solved together (contactGroups), and their coupled blocks of N.
   std::vector<std::vector<Eigen::Index>> groups;
   std::vector<detail::GroupMatrix> group_blocks;
-  detail::GlobalNewtonWorkspace newton;  // the global Newton steps' sparse N
+  detail::GlobalNewtonWorkspace newton;  // the global Newton steps' matrices
   Eigen::VectorXd candidate;             // the global Newton steps' result
 };
 
