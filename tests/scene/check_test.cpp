@@ -401,12 +401,21 @@ TEST(SceneCheck, SpawnInsideAClosedMeshFixtureFires) {
   bowl.shape.mesh_data = twice;
   EXPECT_EQ(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture).size(),
             1u);
-  // An open mesh (the original less its last triangle) bounds nothing: not checked, quiet.
+  // An open mesh (the original less its last triangle) bounds nothing: it cannot be judged, and
+  // the check says so (it was silent) instead of naming it inside.
   auto open = std::make_shared<TriangleMesh>(*bowl.shape.mesh_data);
   open->triangles.resize(open->triangles.size() / 2 - 3);
   bowl.shape.mesh_data = open;
-  EXPECT_TRUE(
-      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnInsideFixture).empty());
+  const std::vector<Hazard> all = checkScene(s, Method::OdeRheonomic);
+  EXPECT_TRUE(ofKind(all, Hazard::Kind::SpawnInsideFixture).empty());
+  const std::vector<Hazard> skipped = ofKind(all, Hazard::Kind::CheckSkipped);
+  ASSERT_EQ(skipped.size(), 1u) << formatHazards(all);
+  EXPECT_NE(skipped[0].message.find("open mesh"), std::string::npos) << skipped[0].message;
+  EXPECT_NE(skipped[0].where.find("fixtures[0].geoms[0]"), std::string::npos);
+  // A region clear of the open mesh's bounding box is not reported.
+  s.parts[0].spawn_min = {5, 5, 5};
+  s.parts[0].spawn_max = {5.1, 5.1, 5.1};
+  EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::CheckSkipped).empty());
 }
 
 // Parts spawned faster than they fall clear of each other overlap unless the region holds them

@@ -265,7 +265,19 @@ bool regionInsideMesh(const Vec3& lo, const Vec3& hi, const Pose& pose, const Tr
   return false;
 }
 
+// Whether the region [lo, hi] and the box b overlap (open intervals).
+bool overlaps(const Vec3& lo, const Vec3& hi, const Box3& b) {
+  return lo.x < b.hi.x && hi.x > b.lo.x && lo.y < b.hi.y && hi.y > b.lo.y && lo.z < b.hi.z &&
+         hi.z > b.lo.z;
+}
+
 }  // namespace
+
+bool openMeshAround(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g) {
+  const Shape& s = g.shape;
+  if (s.kind != Shape::Kind::Mesh || (s.mesh_data && closedMesh(*s.mesh_data))) return false;
+  return overlaps(lo, hi, geomBounds(g));
+}
 
 // Whether the axis-aligned region [lo, hi] (world) reaches into a fixture geom.
 bool regionInsideGeom(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g) {
@@ -288,9 +300,7 @@ bool regionInsideGeom(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g) {
     return norm(nearest - c) < s.radius;
   }
   const Box3 b = geomBounds(g);
-  const bool aabb = lo.x < b.hi.x && hi.x > b.lo.x && lo.y < b.hi.y && hi.y > b.lo.y &&
-                    lo.z < b.hi.z && hi.z > b.lo.z;
-  if (!aabb) return false;
+  if (!overlaps(lo, hi, b)) return false;
   if (s.kind == Shape::Kind::Mesh) return regionInsideMesh(lo, hi, g.pose, *s.mesh_data);
   if (s.kind != Shape::Kind::Box) return true;  // cylinder, capsule: bounding box
   // Box: separating axes of two boxes (the region's 3, the geom's 3, their 9 cross products).

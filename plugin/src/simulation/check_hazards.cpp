@@ -339,6 +339,21 @@ void checkSpawnInsideFixture(const CheckContext& c, std::size_t part, std::vecto
   const PartSpec& p = c.scene.parts[i];
   for (const GeomInfo& gi : c.geoms) {
     const Fixture::Geom& gm = c.scene.fixtures[gi.f].geoms[gi.g];
+    if (openMeshAround(p.spawn_min, p.spawn_max, gm)) {
+      // An open mesh bounds no solid: whether parts start inside its walls cannot be told.
+      Hazard hz;
+      hz.kind = Hazard::Kind::CheckSkipped;
+      hz.where = idx("parts", i) + ".spawn_min, " + idx("parts", i) + ".spawn_max, " +
+                 geomPath(gi.f, gi.g);
+      hz.message = "the spawn region of " + idx("parts", i) + " ('" + p.name +
+                   "') overlaps the bounding box of " + geomPath(gi.f, gi.g) +
+                   ", an open mesh (fixture '" + c.scene.fixtures[gi.f].name +
+                   "'; it bounds no solid): whether parts start inside its walls is not checked";
+      hz.safe_setting = "a closed mesh for " + geomPath(gi.f, gi.g) +
+                        " (every edge shared by two triangles), or check the spawn region by hand";
+      out.push_back(hz);
+      continue;
+    }
     if (!regionInsideGeom(p.spawn_min, p.spawn_max, gm)) continue;
     Hazard hz;
     hz.kind = Hazard::Kind::SpawnInsideFixture;

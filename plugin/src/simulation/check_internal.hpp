@@ -104,6 +104,10 @@ double windingNumber(const TriangleMesh& m, const Vec3& p);
 // it.
 bool closedMesh(const TriangleMesh& m);
 
+// Whether `g` is an open mesh (closedMesh false, or no mesh data) whose world bounding box
+// overlaps the axis-aligned region [lo, hi]: a region regionInsideGeom cannot judge.
+bool openMeshAround(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g);
+
 // Whether the axis-aligned region [lo, hi] (world) reaches into a fixture geom. A closed mesh
 // is the solid it bounds, sampled (regionInsideMesh); an open one bounds none: false.
 bool regionInsideGeom(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g);

@@ -57,8 +57,10 @@ struct Hazard {
     HighRestitution,
     /// A setting the engine of this method does not use (e.g. restitution in the reference).
     IgnoredSetting,
-    /// A test of the check that would take too long was skipped (a fixture mesh's wall
-    /// thickness beyond kMaxMeshRayTests ray tests): the check says so instead of hanging.
+    /// A test of the check that would take too long, or cannot be made, was skipped: a fixture
+    /// mesh's wall thickness beyond kMaxMeshRayTests ray tests (the check says so instead of
+    /// hanging), or a spawn region within the bounding box of an open fixture mesh, which bounds
+    /// no solid, so whether parts start inside its walls cannot be told.
     CheckSkipped,
   };
   Kind kind = Kind::Tunnelling;
