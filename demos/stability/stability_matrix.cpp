@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/output/output.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 #include "stability/stability_cases.hpp"
@@ -54,14 +55,15 @@ void drain(Child& c) {
 
 // Writes every case matching `re` (and `quick`) as `<dir>/<case>.json`; 0 when at least one was
 // written, 2 (with the reason on stderr, and no folder made) otherwise.
-int writeScenes(const std::vector<StabilityCase>& all, const std::regex& re, bool quick,
-                const std::string& dir) {
+int writeScenes(const std::vector<StabilityCase>& all, const std::regex& re,
+                const std::string& filter, bool quick, const std::string& dir) {
   std::vector<const StabilityCase*> matching;
   for (const StabilityCase& c : all) {
     if ((!quick || c.quick) && std::regex_search(c.name, re)) matching.push_back(&c);
   }
   if (matching.empty()) {
-    std::fprintf(stderr, "no case matches\n");
+    std::fprintf(stderr, "--write-scenes: no case matches --filter '%s'%s\n", filter.c_str(),
+                 quick ? " among the quick cases (--quick)" : "");
     return 2;
   }
   std::error_code error;
@@ -73,13 +75,24 @@ int writeScenes(const std::vector<StabilityCase>& all, const std::regex& re, boo
   }
   for (const StabilityCase* c : matching) {
     const std::string path = dir + "/" + c->name + ".json";
+    // A vibrating case's full-vibration runs take the matrix's step (sceneFor) and its rheonomic
+    // runs the case's own, as `rheofeed run` picks them from the file.
+    scene::Scene s = c->scene;
+    std::string note;
+    if (s.hasVibration()) {
+      const scene::Scene fv = sceneFor(*c, scene::Method::OdeFullVibration);
+      if (s.solver.rheonomic_time_step <= 0) s.solver.rheonomic_time_step = s.solver.time_step;
+      s.solver.time_step = fv.solver.time_step;
+      note = " (full vibration: the matrix runs " + formatNumber(fv.duration) +
+             " s of it, --duration " + formatNumber(fv.duration) + ")";
+    }
     try {
-      scene::writeFileAtomically(path, scene::toJson(c->scene));
+      scene::writeFileAtomically(path, scene::toJson(s));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "--write-scenes: %s\n", e.what());
       return 2;
     }
-    std::printf("%s\n", path.c_str());
+    std::printf("%s%s\n", path.c_str(), note.c_str());
   }
   return 0;
 }
@@ -93,17 +106,22 @@ int main(int argc, char** argv) {
   std::string scenes_dir;
   bool quick = false, list = false;
   int jobs = 1;
-  app.add_option("--out", out, "output folder for stability.csv and stability.md")
-      ->capture_default_str();
+  CLI::Option* out_option =
+      app.add_option("--out", out, "output folder for stability.csv and stability.md")
+          ->capture_default_str();
   app.add_option("--filter", filter, "run only the cases whose name matches this regex (search)");
   app.add_flag("--quick", quick, "only the cases that run in seconds (the ctest reduced matrix)");
-  app.add_flag("--list", list, "list the cases and their methods, run nothing");
-  app.add_option("--write-scenes", scenes_dir,
-                 "write the matching cases as scene files (<case>.json) to this folder, for "
-                 "`rheofeed run`, and run nothing");
-  app.add_option("--jobs", jobs, "runs in parallel (forked processes)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 64));
+  CLI::Option* list_option =
+      app.add_flag("--list", list, "list the cases and their methods, run nothing");
+  CLI::Option* write_scenes =
+      app.add_option("--write-scenes", scenes_dir,
+                     "write the matching cases as scene files (<case>.json) to this folder, for "
+                     "`rheofeed run`, and run nothing (a vibrating case's file has the matrix's "
+                     "full-vibration step as solver.time_step)");
+  CLI::Option* jobs_option = app.add_option("--jobs", jobs, "runs in parallel (forked processes)")
+                                 ->capture_default_str()
+                                 ->check(CLI::Range(1, 64));
+  write_scenes->excludes(list_option)->excludes(out_option)->excludes(jobs_option);
   CLI11_PARSE(app, argc, argv);
 
   const std::vector<StabilityCase> all = stabilityCases();
@@ -130,7 +148,13 @@ int main(int argc, char** argv) {
     std::printf("%zu cases of %zu, %zu runs\n", matched, all.size(), runs.size());
     return 0;
   }
-  if (!scenes_dir.empty()) return writeScenes(all, re, quick, scenes_dir);
+  if (app.count("--write-scenes") > 0) {
+    if (scenes_dir.empty()) {
+      std::fprintf(stderr, "--write-scenes: the folder is empty; give a folder to write to\n");
+      return 2;
+    }
+    return writeScenes(all, re, filter, quick, scenes_dir);
+  }
   if (runs.empty()) {
     std::fprintf(stderr, "no case matches\n");
     return 2;
