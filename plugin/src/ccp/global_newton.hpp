@@ -24,7 +24,9 @@ struct GlobalNewtonWorkspace {
   bool prepared = false;
   /// Builds `n` or `minv_d` and the parameters from the problem (once per solve).
   void prepare(const Problem& problem);
-  /// out = N g (3 nc, m/s) for impulses g (3 nc, N s), after prepare().
+  /// out = N g (3 nc, m/s) for impulses g (3 nc, N s), after prepare(). Not multiplyDelassus:
+  /// that uses the solver workspace's generalised-velocity scratch, which NSGS keeps between
+  /// sweeps.
   void multiplyN(const Problem& problem, const Eigen::VectorXd& g, Eigen::VectorXd& out) const;
 };
 

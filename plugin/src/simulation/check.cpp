@@ -86,7 +86,9 @@ void measureFixtures(CheckContext& c) {
     for (std::size_t k = 0; k < fx.geoms.size(); ++k) {
       const Fixture::Geom& gm = fx.geoms[k];
       const Box3 b = geomBounds(gm);
-      c.geoms.push_back({f, k, b});
+      const bool open_mesh = gm.shape.kind == Shape::Kind::Mesh &&
+                             (!gm.shape.mesh_data || !closedMesh(*gm.shape.mesh_data));
+      c.geoms.push_back({f, k, b, open_mesh});
       if (b.bounded) {
         all.add(b.lo);
         all.add(b.hi);

@@ -265,18 +265,11 @@ bool regionInsideMesh(const Vec3& lo, const Vec3& hi, const Pose& pose, const Tr
   return false;
 }
 
-// Whether the region [lo, hi] and the box b overlap (open intervals).
+}  // namespace
+
 bool overlaps(const Vec3& lo, const Vec3& hi, const Box3& b) {
   return lo.x < b.hi.x && hi.x > b.lo.x && lo.y < b.hi.y && hi.y > b.lo.y && lo.z < b.hi.z &&
          hi.z > b.lo.z;
-}
-
-}  // namespace
-
-bool openMeshAround(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g) {
-  const Shape& s = g.shape;
-  if (s.kind != Shape::Kind::Mesh || (s.mesh_data && closedMesh(*s.mesh_data))) return false;
-  return overlaps(lo, hi, geomBounds(g));
 }
 
 // Whether the axis-aligned region [lo, hi] (world) reaches into a fixture geom.

@@ -339,7 +339,7 @@ void checkSpawnInsideFixture(const CheckContext& c, std::size_t part, std::vecto
   const PartSpec& p = c.scene.parts[i];
   for (const GeomInfo& gi : c.geoms) {
     const Fixture::Geom& gm = c.scene.fixtures[gi.f].geoms[gi.g];
-    if (openMeshAround(p.spawn_min, p.spawn_max, gm)) {
+    if (gi.open_mesh && overlaps(p.spawn_min, p.spawn_max, gi.bounds)) {
       // An open mesh bounds no solid: whether parts start inside its walls cannot be told.
       Hazard hz;
       hz.kind = Hazard::Kind::CheckSkipped;
@@ -354,7 +354,7 @@ void checkSpawnInsideFixture(const CheckContext& c, std::size_t part, std::vecto
       out.push_back(hz);
       continue;
     }
-    if (!regionInsideGeom(p.spawn_min, p.spawn_max, gm)) continue;
+    if (gi.open_mesh || !regionInsideGeom(p.spawn_min, p.spawn_max, gm)) continue;
     Hazard hz;
     hz.kind = Hazard::Kind::SpawnInsideFixture;
     hz.where =

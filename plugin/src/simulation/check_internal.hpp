@@ -104,9 +104,8 @@ double windingNumber(const TriangleMesh& m, const Vec3& p);
 // it.
 bool closedMesh(const TriangleMesh& m);
 
-// Whether `g` is an open mesh (closedMesh false, or no mesh data) whose world bounding box
-// overlaps the axis-aligned region [lo, hi]: a region regionInsideGeom cannot judge.
-bool openMeshAround(const Vec3& lo, const Vec3& hi, const Fixture::Geom& g);
+// Whether the region [lo, hi] and the box b overlap (open intervals).
+bool overlaps(const Vec3& lo, const Vec3& hi, const Box3& b);
 
 // Whether the axis-aligned region [lo, hi] (world) reaches into a fixture geom. A closed mesh
 // is the solid it bounds, sampled (regionInsideMesh); an open one bounds none: false.
@@ -135,6 +134,7 @@ struct CheckContext {
   struct GeomInfo {
     std::size_t f, g;
     Box3 bounds;
+    bool open_mesh = false;  // a mesh that bounds no solid (closedMesh false, or no data)
   };
   std::vector<GeomInfo> geoms;
   double thinnest_fixture = kInf, lowest_top = kInf;
