@@ -81,8 +81,11 @@ std::string summaryJson(const RunMetrics& r) {
   }
   json += "], \"part_events_dropped\": " + std::to_string(h.part_events_dropped) +
           ", \"part_events\": [";
-  for (std::size_t k = 0; k < h.part_events.size(); ++k) {
-    const PartEvent& e = h.part_events[k];
+  std::vector<const PartEvent*> events;
+  for (const PartEvent& e : h.part_events) events.push_back(&e);
+  for (const PartEvent& e : h.inside_fixture_now) events.push_back(&e);
+  for (std::size_t k = 0; k < events.size(); ++k) {
+    const PartEvent& e = *events[k];
     const auto vec = [](const Vec3& v) {
       return "[" + jsonNumber(v.x) + ", " + jsonNumber(v.y) + ", " + jsonNumber(v.z) + "]";
     };

@@ -56,6 +56,23 @@ void HealthReport::onEnd(const Simulation& sim) {
     std::fprintf(stderr, "rheofeed: %s, %s: %s\n", scene_name_.c_str(), toString(sim.method()),
                  healthSummary(h, sim.numParts()).c_str());
   }
+  // The parts inside a fixture at the end are lost (partsLost) but were never reported as they
+  // went in: name them (the first few; all are in the run JSON).
+  constexpr std::size_t kInsideNamed = 5;
+  for (std::size_t k = 0; k < h.inside_fixture_now.size() && k < kInsideNamed; ++k) {
+    const PartEvent& e = h.inside_fixture_now[k];
+    std::fprintf(stderr,
+                 "rheofeed: %s, %s: part %d went into fixture %s at t = %g s and is inside it at "
+                 "the end, x = (%g, %g, %g) m\n",
+                 scene_name_.c_str(), toString(sim.method()), e.part,
+                 e.fixture.empty() ? "(unknown)" : e.fixture.c_str(), e.time, e.position.x,
+                 e.position.y, e.position.z);
+  }
+  if (h.inside_fixture_now.size() > kInsideNamed) {
+    std::fprintf(stderr, "rheofeed: %s, %s: ... and %zu more parts inside a fixture (run JSON)\n",
+                 scene_name_.c_str(), toString(sim.method()),
+                 h.inside_fixture_now.size() - kInsideNamed);
+  }
   if (h.local_law_feeders > 0) {
     const LocalDriftStats& l = h.local_law;
     std::fprintf(stderr,

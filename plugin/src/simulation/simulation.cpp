@@ -520,6 +520,7 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const Vec3&
       return;
     }
     tr.inside = true;  // the anchor is inside a fixture now
+    tr.entry_time = time_;
     tr.outside_point = from;
     tr.entry_point = from + forward * u;
     tr.entry_normal = dot(normal, u) < 0 ? normal : -normal;  // outward: against the motion
@@ -704,7 +705,9 @@ void PartSimulation::step() {
     }
     checkPhysicalSpeed(i, s);
     tr.beyond_exit = tr.beyond_exit || beyondExitPlane(scene_.outputs, s.position);
-    if (!tr.counted && !tr.beyond_exit) {
+    // Beyond the exit plane a part is out of the measurement, but one that crossed it inside a
+    // fixture is followed until it comes out (else it would stay "inside" for the rest of the run).
+    if (!tr.counted && (!tr.beyond_exit || tr.inside)) {
       const Vec3 from = anchorAt(i, tr.last), to = anchorAt(i, s);
       if (tr.inside || norm(to - from) > kTunnelCheckFraction * tr.clearance) {
         trackCrossings(i, from, to, s);
@@ -722,8 +725,22 @@ void PartSimulation::step() {
     tr.last = s;
   }
   health_.parts_inside_fixture = 0;
-  for (const Track& tr : tracks_) {
-    if (tr.active && tr.inside && !tr.counted) ++health_.parts_inside_fixture;
+  health_.inside_fixture_now.clear();
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    const Track& tr = tracks_[i];
+    if (!tr.active || !tr.inside || tr.counted) continue;
+    ++health_.parts_inside_fixture;
+    PartEvent e;
+    e.part = static_cast<int>(i);
+    e.time = tr.entry_time;
+    e.kind = "inside_fixture";
+    e.what = "went into a fixture and is inside it now";
+    if (tr.entry_fixture >= 0 && tr.entry_fixture < static_cast<int>(scene_.fixtures.size())) {
+      e.fixture = scene_.fixtures[static_cast<std::size_t>(tr.entry_fixture)].name;
+    }
+    e.position = tr.last.position;
+    e.velocity = tr.last.velocity;
+    health_.inside_fixture_now.push_back(std::move(e));
   }
   totals_ = fixtureImpulses(h);
   spawnDue();

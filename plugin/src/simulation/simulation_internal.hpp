@@ -110,6 +110,7 @@ class PartSimulation : public Simulation {
     int entry_fixture = -1;        // the fixture it went into (index in the scene), -1 unknown
     dGeomID entry_geom = nullptr;  // ... and the geom
     Vec3 outside_point;            // the last anchor outside before it went in (m)
+    double entry_time = 0;         // when it went in (s)
     // Left the feeder (RunHealth): touched a feeder; fixtures that supported it before that;
     // a fixture not among its carriers supported it in the last step.
     bool on_feeder = false;

@@ -37,9 +37,11 @@ struct PartEvent {
   int part = -1;        ///< the part's index (spawn order)
   double time = 0;      ///< simulated time of the step that found it (s)
   std::string kind;     ///< the count it went to: "through_fixture", "sunk", "left_feeder",
-                        ///< "fell", "out_of_bounds", "nonfinite" or "too_fast"
+                        ///< "fell", "out_of_bounds", "nonfinite" or "too_fast"; or
+                        ///< "inside_fixture" (RunHealth::inside_fixture_now)
   std::string what;     ///< what happened, as printed on stderr for the first of its kind
-  std::string fixture;  ///< the fixture it went into (through_fixture, sunk), else empty
+  std::string fixture;  ///< the fixture it went into (through_fixture, sunk, inside_fixture),
+                        ///< else empty
   Vec3 position;        ///< its centre then (m, world frame)
   Vec3 velocity;        ///< its centre's velocity then (m/s, world frame)
 };
@@ -108,7 +110,8 @@ struct RunHealth {
   /// through a fixture (tunnelling: through a floor or a wall): within one step, or into it and
   /// out on another side, or into it and then out of the scene. They stay in the simulation
   /// until they leave it; each part is counted once. Parts beyond the exit plane are not checked
-  /// (they are out of the measurement).
+  /// (they are out of the measurement), except one that crossed it inside a fixture: it is
+  /// followed until it comes out, and counted as any other.
   int parts_through_fixture = 0;
   /// Parts that left the feeder without crossing the exit plane: over a wall, a rim or a side,
   /// onto a catch floor or into the air beyond the feeder's footprint (rule above). Kept in
@@ -188,9 +191,13 @@ struct RunHealth {
   long warm_started_contacts = 0;
   /// Every part counted above (lost, sunk), in the order found: the first kMaxPartEvents of the
   /// run, and how many more there were. Written to the run JSON (health.part_events). Parts
-  /// inside a fixture (a gauge) are not listed until they are counted otherwise.
+  /// inside a fixture (a gauge) are not listed here until they are counted otherwise.
   std::vector<PartEvent> part_events;
   long part_events_dropped = 0;
+  /// The parts counted in parts_inside_fixture now (a gauge, like it), kind "inside_fixture":
+  /// the time they went in (s), their centre and its velocity now (m, m/s, world frame), the
+  /// fixture. The run JSON lists them after part_events.
+  std::vector<PartEvent> inside_fixture_now;
   /// Parts lost in any way but the exit: fell + through_fixture + left_feeder + out_of_bounds +
   /// nonfinite + too_fast, plus those inside a fixture now.
   int partsLost() const {
