@@ -9,7 +9,8 @@
 //                             GNU parallel or on Slurm; `sweep collect DIR` gathers the results
 // SCENE is the name of a shipped scene (demos/scenes, installed in share/rheofeed/scenes; see
 // shipped_scenes.hpp) or a scene file. Exit codes: 0 success, 1 a failure while running (check:
-// the scene has hazards), 2 bad input (command line or scene; nothing has run).
+// the scene has hazards; run: a run lost every part it spawned), 2 bad input (command line or
+// scene; nothing has run).
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -122,7 +123,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("rheofeed ") + RHEOFEED_VERSION);
   app.require_subcommand(1);
   app.footer(
-      "Exit codes: 0 success; 1 a failure while running (check: hazards found); 2 bad "
+      "Exit codes: 0 success; 1 a failure while running (check: hazards found; run: a run lost "
+      "every part it spawned, its outputs written); 2 bad "
       "input (command line or scene), nothing has run.\nShipped scenes (" +
       (dataDir() / "scenes").string() + "): " + shippedList());
 

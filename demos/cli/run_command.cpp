@@ -281,6 +281,7 @@ int runCommand(const RunArgs& args) {
         unit.c_str());
     std::fflush(stdout);
     std::vector<std::pair<std::string, std::string>> blocks;
+    std::vector<std::string> all_lost;  // runs that lost every part they spawned
     for (std::size_t k = 0; k < plan.runs.size(); ++k) {
       const PlannedRun& run = plan.runs[k];
       const Method m = run.method;
@@ -309,6 +310,10 @@ int runCommand(const RunArgs& args) {
                   r.throughput, r.cpu_seconds, r.real_time_factor, h.partsLost(),
                   100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps));
       std::fflush(stdout);
+      if (r.parts > 0 && h.partsLost() >= r.parts) {
+        all_lost.push_back(std::string(toString(m)) + " lost all " + std::to_string(r.parts) +
+                           " parts it spawned");
+      }
     }
     if (blocks.size() > 1) {
       plotRuns(blocks, plan.scene.name + ": methods compared", "mean drift (" + unit + ")", "1:3",
@@ -329,6 +334,14 @@ int runCommand(const RunArgs& args) {
                   page.string().c_str());
     }
     if (table) table->save();  // last: a table that cannot be written costs no other output
+    // Written and said, but a run with no part left has no answer to give: not a success.
+    if (!all_lost.empty()) {
+      std::string what;
+      for (const std::string& a : all_lost) what += (what.empty() ? "" : "; ") + a;
+      throw std::runtime_error(what +
+                               " (its outputs are written; stderr and the JSON's "
+                               "health.part_events say how)");
+    }
   });
 }
 
