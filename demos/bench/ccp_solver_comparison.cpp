@@ -45,7 +45,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
@@ -61,6 +60,7 @@
 #include "rheofeed/ccp/ipm.hpp"
 #include "rheofeed/ccp/nsgs.hpp"
 #include "rheofeed/ccp/solver.hpp"
+#include "rheofeed/output/output.hpp"
 #include "rheofeed/output/plot.hpp"
 #include "rheofeed/reference/contact_problem.hpp"
 #include "rheofeed/scene/scene_io.hpp"
@@ -290,16 +290,6 @@ std::string profilesCsv(const std::vector<Run>& runs, const std::vector<std::str
     }
   }
   return csv.str();
-}
-
-void writeAtomically(const fs::path& path, const std::string& text) {
-  const fs::path temporary = path.string() + ".partial";
-  {
-    std::ofstream file(temporary);
-    file << text;
-    if (!file) throw std::runtime_error("cannot write " + temporary.string());
-  }
-  fs::rename(temporary, path);
 }
 
 std::string markdown(const std::vector<Run>& runs, const std::vector<std::string>& names,
@@ -536,7 +526,8 @@ int main(int argc, char** argv) {
           << r.iterations << "," << formatDouble("%.6g", r.time_s) << ","
           << formatDouble("%.3e", r.residual) << "," << r.local_fallbacks << "\n";
     }
-    writeAtomically(fs::path(out_dir) / "ccp_solver_comparison.csv", csv.str());
+    rheofeed::scene::writeFileAtomically(fs::path(out_dir) / "ccp_solver_comparison.csv",
+                                         csv.str());
     std::ostringstream profiles;
     profiles << "tolerance,solver,tau,fraction\n";
     std::vector<std::pair<std::string, std::string>> blocks;
@@ -558,7 +549,8 @@ int main(int argc, char** argv) {
                  (k + 1 < names.size() ? ", " : "\n");
       }
     }
-    writeAtomically(fs::path(out_dir) / "ccp_solver_comparison_profiles.csv", profiles.str());
+    rheofeed::scene::writeFileAtomically(fs::path(out_dir) / "ccp_solver_comparison_profiles.csv",
+                                         profiles.str());
     const std::string script =
         "set datafile separator ','\nset multiplot layout 1,3\nset logscale x 2\n"
         "set xrange [1:" +
@@ -571,8 +563,8 @@ int main(int argc, char** argv) {
                                   (fs::path(out_dir) / "ccp_solver_comparison.png").string())) {
       std::fprintf(stderr, "warning: the profile plot was not written (gnuplot)\n");
     }
-    writeAtomically(fs::path(out_dir) / "ccp_solver_comparison.md",
-                    markdown(runs, names, problems, time_limit, skipped));
+    rheofeed::scene::writeFileAtomically(fs::path(out_dir) / "ccp_solver_comparison.md",
+                                         markdown(runs, names, problems, time_limit, skipped));
     std::fprintf(stderr, "outputs in %s\n", out_dir.c_str());
   } catch (const std::exception& error) {
     std::fprintf(stderr, "ccp_solver_comparison: %s\n", error.what());
