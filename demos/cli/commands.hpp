@@ -2,7 +2,8 @@
 // The subcommands of `rheofeed` (main.cpp parses the command line). Each returns the process exit
 // code: 0 success, 2 bad input (a message on stderr naming the value, where it came from and the
 // allowed range; nothing has run), 1 a failure while running (e.g. an output that cannot be
-// written); `check` returns 1 when the scene has hazards.
+// written); `check` returns 1 when the scene has hazards; `run` returns kNoAnswerExitCode when a
+// run gave no answer.
 #pragma once
 
 #include <functional>
@@ -34,6 +35,11 @@ struct RunArgs {
   bool cycles_given = false;
 };
 int runCommand(const RunArgs& args);
+/// `rheofeed run`'s exit code when every run finished and its outputs are written but a run
+/// measured no part and saw none cross the exit (every part lost, spawned beyond the exit plane,
+/// or none spawned): a run with no answer. Sweep jobs record such a point, with its health, as
+/// done (sweep_job.cpp).
+inline constexpr int kNoAnswerExitCode = 3;
 
 /// Says on stderr ("<program>: note: ... ignored: <why>") that --warmup-cycles / --measure-cycles
 /// were given but no sampling run took them: nothing calibrated, or --classical.

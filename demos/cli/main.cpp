@@ -9,8 +9,8 @@
 //                             GNU parallel or on Slurm; `sweep collect DIR` gathers the results
 // SCENE is the name of a shipped scene (demos/scenes, installed in share/rheofeed/scenes; see
 // shipped_scenes.hpp) or a scene file. Exit codes: 0 success, 1 a failure while running (check:
-// the scene has hazards; run: a run lost every part it spawned), 2 bad input (command line or
-// scene; nothing has run).
+// the scene has hazards), 2 bad input (command line or scene; nothing has run), 3 (run) a run
+// gave no answer: it measured no part and none crossed the exit (kNoAnswerExitCode).
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -123,9 +123,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("rheofeed ") + RHEOFEED_VERSION);
   app.require_subcommand(1);
   app.footer(
-      "Exit codes: 0 success; 1 a failure while running (check: hazards found; run: a run lost "
-      "every part it spawned, its outputs written); 2 bad "
-      "input (command line or scene), nothing has run.\nShipped scenes (" +
+      "Exit codes: 0 success; 1 a failure while running (check: hazards found); 2 bad input "
+      "(command line or scene), nothing has run; 3 (run) a run gave no answer: it measured no "
+      "part and none crossed the exit (every part lost, say), its outputs written.\nShipped "
+      "scenes (" +
       (dataDir() / "scenes").string() + "): " + shippedList());
 
   RunArgs run;

@@ -239,7 +239,8 @@ int runCommand(const RunArgs& args) {
     return 2;
   }
 
-  return runChecked("rheofeed run", [&] {
+  std::vector<std::string> no_answer;  // runs with no part measured (kNoAnswerExitCode)
+  const int code = runChecked("rheofeed run", [&] {
     // A rheonomic run of a vibrating feeder needs its drift field: calibrated once, here, when
     // the scene does not give it (`rheofeed calibrate` saves it into the scene).
     bool any_rheonomic = false;
@@ -281,7 +282,6 @@ int runCommand(const RunArgs& args) {
         unit.c_str());
     std::fflush(stdout);
     std::vector<std::pair<std::string, std::string>> blocks;
-    std::vector<std::string> all_lost;  // runs that lost every part they spawned
     for (std::size_t k = 0; k < plan.runs.size(); ++k) {
       const PlannedRun& run = plan.runs[k];
       const Method m = run.method;
@@ -304,15 +304,23 @@ int runCommand(const RunArgs& args) {
       blocks.emplace_back(toString(m), seriesCsv(r));
       const RunHealth& h = r.health;
       char ci[32] = "n/a";  // no confidence interval over fewer than two parts
-      if (ci95Defined(r.parts)) std::snprintf(ci, sizeof ci, "%.5f", r.mean_drift_ci95);
-      std::printf("| %s | %.3g | %d | %.5f | %s | %.4f | %.2f | %.2f | %.4f | %d | %.1f %% |\n",
-                  toString(m), r.time_step, r.parts, r.mean_drift, ci, r.vertical_displacement,
+      if (ci95Defined(r.drift_parts)) std::snprintf(ci, sizeof ci, "%.5f", r.mean_drift_ci95);
+      char drift[32] = "n/a";  // no part measured
+      if (r.drift_parts > 0) std::snprintf(drift, sizeof drift, "%.5f", r.mean_drift);
+      std::printf("| %s | %.3g | %d | %s | %s | %.4f | %.2f | %.2f | %.4f | %d | %.1f %% |\n",
+                  toString(m), r.time_step, r.parts, drift, ci, r.vertical_displacement,
                   r.throughput, r.cpu_seconds, r.real_time_factor, h.partsLost(),
                   100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps));
       std::fflush(stdout);
-      if (r.parts > 0 && h.partsLost() >= r.parts) {
-        all_lost.push_back(std::string(toString(m)) + " lost all " + std::to_string(r.parts) +
-                           " parts it spawned");
+      if (r.drift_parts == 0 && r.feeder.exit_times.empty()) {
+        const std::string why = r.parts == 0 ? "spawned no part"
+                                : h.partsLost() >= r.parts
+                                    ? "lost all " + std::to_string(r.parts) + " parts it spawned"
+                                    : "measured none of its " + std::to_string(r.parts) +
+                                          " parts (" + std::to_string(h.partsLost()) + " lost, " +
+                                          std::to_string(r.feeder.spawned_beyond_exit) +
+                                          " spawned beyond the exit plane)";
+        no_answer.push_back(std::string(toString(m)) + " " + why);
       }
     }
     if (blocks.size() > 1) {
@@ -334,15 +342,15 @@ int runCommand(const RunArgs& args) {
                   page.string().c_str());
     }
     if (table) table->save();  // last: a table that cannot be written costs no other output
-    // Written and said, but a run with no part left has no answer to give: not a success.
-    if (!all_lost.empty()) {
-      std::string what;
-      for (const std::string& a : all_lost) what += (what.empty() ? "" : "; ") + a;
-      throw std::runtime_error(what +
-                               " (its outputs are written; stderr and the JSON's "
-                               "health.part_events say how)");
+    // Written and said, but a run that measured no part and saw none leave has no answer.
+    for (const std::string& a : no_answer) {
+      std::fprintf(stderr,
+                   "rheofeed run: no answer: %s (its outputs are written; stderr and the JSON's "
+                   "health say why); exit code %d\n",
+                   a.c_str(), kNoAnswerExitCode);
     }
   });
+  return code != 0 ? code : no_answer.empty() ? 0 : kNoAnswerExitCode;
 }
 
 }  // namespace rheofeed::cli

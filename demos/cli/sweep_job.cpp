@@ -25,6 +25,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "cli/commands.hpp"
 #include "cli/sweep.hpp"
 #include "rheofeed/output/output.hpp"
 
@@ -638,6 +639,9 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
       if (WIFSIGNALED(status)) {
         error = "rheofeed run killed by signal " + std::to_string(WTERMSIG(status)) + " (" +
                 strsignal(WTERMSIG(status)) + ")";
+      } else if (WEXITSTATUS(status) == kNoAnswerExitCode) {
+        // every part lost, say: a valid point of the sweep, read with its health
+        record["no_answer"] = lastMessage(log);
       } else if (WEXITSTATUS(status) != 0) {
         error = "rheofeed run exited with code " + std::to_string(WEXITSTATUS(status)) + ": " +
                 lastMessage(log) + " (log: " + log.string() + ")";

@@ -99,6 +99,7 @@ FeederMetrics feeder() {
   cubes.spawned = 5;
   cubes.exited = 2;
   cubes.removed_without_exit = 1;
+  cubes.lost_before_exit = 2;
   cubes.up_axis = {0, 0, 0, 0, 2, 0};
   FamilyExits balls;
   balls.name = "nut, \"M6\"";
@@ -111,6 +112,7 @@ FeederMetrics feeder() {
   again.spawned = 4;
   again.exited = 0;
   again.removed_without_exit = 0;
+  again.lost_before_exit = 0;
   again.up_axis = {};
   f.families = {cubes, balls, again};
   return f;
@@ -225,14 +227,15 @@ TEST(OrientationCsv, OneRowPerFamilyWithItsCountsAndHistogram) {
   const FeederMetrics f = feeder();
   const auto rows = parseCsv(orientationCsv(f));
   ASSERT_EQ(rows.size(), 4u);
-  EXPECT_EQ(rows[0], (std::vector<std::string>{"family", "shape", "spawned", "exited",
-                                               "removed_without_exit", "orientation_meaningful",
-                                               "+x", "-x", "+y", "-y", "+z", "-z"}));
-  EXPECT_EQ(rows[1], (std::vector<std::string>{"cubes", "box", "5", "2", "1", "true", "0", "0", "0",
-                                               "0", "2", "0"}));
+  EXPECT_EQ(rows[0],
+            (std::vector<std::string>{
+                "family", "shape", "spawned", "exited", "removed_without_exit", "lost_before_exit",
+                "orientation_meaningful", "+x", "-x", "+y", "-y", "+z", "-z"}));
+  EXPECT_EQ(rows[1], (std::vector<std::string>{"cubes", "box", "5", "2", "1", "2", "true", "0", "0",
+                                               "0", "0", "2", "0"}));
   // The comma and the quotes survive the CSV quoting; the repeated name gets its index.
-  EXPECT_EQ(rows[2], (std::vector<std::string>{"nut, \"M6\"", "sphere", "3", "1", "0", "false", "1",
-                                               "0", "0", "0", "0", "0"}));
+  EXPECT_EQ(rows[2], (std::vector<std::string>{"nut, \"M6\"", "sphere", "3", "1", "0", "0", "false",
+                                               "1", "0", "0", "0", "0", "0"}));
   EXPECT_EQ(rows[3][0], "cubes[2]");
   EXPECT_EQ(rows[3][2], "4");
 }
@@ -262,6 +265,7 @@ TEST(FeederJson, ParsesToTheMetricsWritten) {
   EXPECT_EQ(j["families"]["cubes"]["spawned"], 5);
   EXPECT_EQ(j["families"]["cubes"]["exited"], 2);
   EXPECT_EQ(j["families"]["cubes"]["removed_without_exit"], 1);
+  EXPECT_EQ(j["families"]["cubes"]["lost_before_exit"], 2);
   EXPECT_EQ(j["families"]["nut, \"M6\""]["orientation_meaningful"], false);
   EXPECT_EQ(j["families"]["cubes[2]"]["spawned"], 4);
   EXPECT_EQ(j["exit_orientation"]["cubes"]["+z"], 2);

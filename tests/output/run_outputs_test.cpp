@@ -57,6 +57,7 @@ RunMetrics run() {
   r.vertical_displacement = -0.0004;
   r.throughput = 1.5;
   r.parts = 12;
+  r.drift_parts = 12;
   r.cpu_seconds = 2.5;
   r.simulated_seconds = 10;
   r.warmup = 1.5;
@@ -139,12 +140,24 @@ TEST(SeriesCsv, AnAngularDriftNamesItsUnitRadiansPerSecond) {
 TEST(SummaryJson, OnePartHasNoConfidenceInterval) {
   RunMetrics r = run();
   r.parts = 1;
+  r.drift_parts = 1;
   for (DriftSample& d : r.series) d.parts = 1;
   EXPECT_TRUE(json::parse(summaryJson(r))["mean_drift_ci95"].is_null());
   const std::string csv = seriesCsv(r);
   const std::string row =
       csv.substr(csv.find('\n') + 1, csv.find('\n', csv.find('\n') + 1) - csv.find('\n') - 1);
   EXPECT_NE(row.find(",1,0.012345679,,"), std::string::npos) << row;  // parts, drift, no ci95
+}
+
+// Twelve parts spawned, none measured (all lost, or spawned beyond the exit): no mean drift and
+// no interval - null, not a 0 +- 0 that reads as a feeder standing still.
+TEST(SummaryJson, NoPartMeasuredHasNoMeanDrift) {
+  RunMetrics r = run();
+  r.drift_parts = 0;
+  const json j = json::parse(summaryJson(r));
+  EXPECT_TRUE(j["mean_drift"].is_null());
+  EXPECT_TRUE(j["mean_drift_ci95"].is_null());
+  EXPECT_EQ(j["parts"], 12);
 }
 
 TEST(SummaryJson, ParsesToTheRunMetricsWritten) {

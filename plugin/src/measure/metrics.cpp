@@ -247,6 +247,12 @@ class RunMeter : public RunObserver {
         endMeasurement(tr, t);
         continue;
       }
+      if (sim.partLost(i)) {  // counted lost and kept: its measurement ends here, no exit
+        ++familyOf(i).lost_before_exit;
+        tr.end = x;
+        endMeasurement(tr, t);
+        continue;
+      }
       if (tr.start_time < 0 && t >= out_.warmup) {
         tr.start = x;
         tr.start_turned = tr.turned;
@@ -298,7 +304,10 @@ class RunMeter : public RunObserver {
     const Vec3 d = out_.conveying_direction;
     std::vector<double> drift;
     double dz = 0;
+    int counted = 0;  // parts in the vertical displacement
     for (int i = 0; i < m_.parts; ++i) {
+      if (sim.partLost(i)) continue;  // a lost part's motion is not the feeder's
+      ++counted;
       Track& tr = tracks_[static_cast<std::size_t>(i)];
       const Vec3 x = sim.part(i).position;
       if (!tr.exited || tr.end_time < 0) {
@@ -316,7 +325,8 @@ class RunMeter : public RunObserver {
     }
     m_.mean_drift = mean(drift);
     m_.mean_drift_ci95 = ci95(drift);
-    m_.vertical_displacement = m_.parts ? dz / m_.parts : 0;
+    m_.drift_parts = static_cast<int>(drift.size());
+    m_.vertical_displacement = counted ? dz / counted : 0;
     const double window = m_.simulated_seconds - out_.warmup;
     m_.throughput = window > 0 ? exited_after_warmup_ / window : 0;
   }

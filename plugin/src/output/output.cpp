@@ -121,7 +121,7 @@ std::string exitsCsv(const FeederMetrics& feeder) {
 
 std::string orientationCsv(const FeederMetrics& feeder) {
   std::ostringstream s;
-  s << "family,shape,spawned,exited,removed_without_exit,orientation_meaningful";
+  s << "family,shape,spawned,exited,removed_without_exit,lost_before_exit,orientation_meaningful";
   for (int a = 0; a < kUpAxisCount; ++a) s << "," << toString(static_cast<UpAxis>(a));
   s << "\n";
   const std::vector<std::string> keys = familyKeys(feeder);
@@ -134,7 +134,8 @@ std::string orientationCsv(const FeederMetrics& feeder) {
       name = q + "\"";
     }
     s << name << "," << toString(f.shape) << "," << f.spawned << "," << f.exited << ","
-      << f.removed_without_exit << "," << (f.orientation_meaningful ? "true" : "false");
+      << f.removed_without_exit << "," << f.lost_before_exit << ","
+      << (f.orientation_meaningful ? "true" : "false");
     for (int n : f.up_axis) s << "," << n;
     s << "\n";
   }
@@ -170,6 +171,7 @@ std::string feederJson(const FeederMetrics& f) {
       << ": {\"shape\": " << jsonQuoted(toString(fam.shape)) << ", \"spawned\": " << fam.spawned
       << ", \"exited\": " << fam.exited
       << ", \"removed_without_exit\": " << fam.removed_without_exit
+      << ", \"lost_before_exit\": " << fam.lost_before_exit
       << ", \"orientation_meaningful\": " << (fam.orientation_meaningful ? "true" : "false") << "}";
   }
   s << "}, \"exit_orientation\": {";

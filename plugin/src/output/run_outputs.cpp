@@ -34,15 +34,17 @@ std::string seriesCsv(const RunMetrics& run) {
 
 std::string summaryJson(const RunMetrics& r) {
   char ci[32] = "null";  // no confidence interval over fewer than two parts
-  if (ci95Defined(r.parts)) std::snprintf(ci, sizeof ci, "%.8g", r.mean_drift_ci95);
+  if (ci95Defined(r.drift_parts)) std::snprintf(ci, sizeof ci, "%.8g", r.mean_drift_ci95);
+  char drift[32] = "null";  // no part measured
+  if (r.drift_parts > 0) std::snprintf(drift, sizeof drift, "%.8g", r.mean_drift);
   char b[768];
   std::snprintf(b, sizeof b,
                 ", \"method\": \"%s\", \"time_step_s\": %.8g, \"parts\": %d, "
-                "\"drift_unit\": \"%s\", \"mean_drift\": %.8g, \"mean_drift_ci95\": %s, "
+                "\"drift_unit\": \"%s\", \"mean_drift\": %s, \"mean_drift_ci95\": %s, "
                 "\"vertical_displacement_m\": %.8g, \"throughput_parts_per_s\": %.8g, "
                 "\"cpu_seconds\": %.6g, \"simulated_seconds\": %.6g, \"real_time_factor\": %.6g",
-                toString(r.method), r.time_step, r.parts, r.angular ? "rad/s" : "m/s", r.mean_drift,
-                ci, r.vertical_displacement, r.throughput, r.cpu_seconds, r.simulated_seconds,
+                toString(r.method), r.time_step, r.parts, r.angular ? "rad/s" : "m/s", drift, ci,
+                r.vertical_displacement, r.throughput, r.cpu_seconds, r.simulated_seconds,
                 r.real_time_factor);
   std::string run = b;  // the run's own settings: seed and drift models
   run += ", \"warmup_s\": " + formatNumber(r.warmup);  // the mean drift's window starts there

@@ -536,9 +536,13 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const Vec3&
     tr.entry_normal = dot(normal, u) < 0 ? normal : -normal;
     tr.entry_fixture = fixture;
     tr.entry_geom = geom;
+    tr.entry_time = time_;
     return;
   }
   tr.inside = false;
+  // Beyond the exit plane the part is out of the measurement (the metrics may have counted it
+  // as an exit): coming out only ends its being inside, it is not counted.
+  if (tr.beyond_exit) return;
   const Vec3 exit_normal = dot(normal, u) > 0 ? normal : -normal;  // outward: along the motion
   // Through: out on the far side, the exit surface facing away from the entry surface. Out on
   // the side it entered, or on a face beside it (a corner cut: into a wall's face near its
@@ -616,6 +620,7 @@ void PartSimulation::countLoss(std::size_t i, const char* key, const std::string
   Track& tr = tracks_[i];
   if (tr.counted) return;
   tr.counted = true;
+  tr.lost = true;
   ++counter;
   recordEvent(i, key, what, state);
   std::ostringstream line;
@@ -706,7 +711,8 @@ void PartSimulation::step() {
     checkPhysicalSpeed(i, s);
     tr.beyond_exit = tr.beyond_exit || beyondExitPlane(scene_.outputs, s.position);
     // Beyond the exit plane a part is out of the measurement, but one that crossed it inside a
-    // fixture is followed until it comes out (else it would stay "inside" for the rest of the run).
+    // fixture is followed until it comes out (else it would stay "inside" for the rest of the
+    // run); coming out there is not counted (trackCrossings).
     if (!tr.counted && (!tr.beyond_exit || tr.inside)) {
       const Vec3 from = anchorAt(i, tr.last), to = anchorAt(i, s);
       if (tr.inside || norm(to - from) > kTunnelCheckFraction * tr.clearance) {

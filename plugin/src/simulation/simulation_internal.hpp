@@ -40,6 +40,7 @@ class PartSimulation : public Simulation {
   ContactTotals contactTotals() const final { return totals_; }
   Method method() const final { return method_; }
   const RunHealth& health() const final { return health_; }
+  bool partLost(int index) const final { return tracks_.at(static_cast<std::size_t>(index)).lost; }
   void setStageTiming(bool on) final { stage_timing_ = on; }
   const StageTimes& stageTimes() const final { return stage_times_; }
 
@@ -103,6 +104,7 @@ class PartSimulation : public Simulation {
     bool engine_nonfinite = false;  // the engine reported the state non-finite (markNonFinite)
     bool beyond_exit = false;       // has been beyond the exit plane
     bool counted = false;           // counted in a RunHealth loss (or as an exit) already
+    bool lost = false;              // counted in a RunHealth loss (partLost)
     bool sunk_counted = false;      // counted in parts_sunk already
     // Anchor inside a fixture: where it entered (m) and the entry surface's outward normal.
     bool inside = false;

@@ -89,6 +89,10 @@ struct FamilyExits {
   int spawned = 0;               ///< parts of this family spawned during the run
   int exited = 0;                ///< crossed the exit plane
   int removed_without_exit = 0;  ///< taken out of the simulation before the exit (RunHealth)
+  /// Counted lost (Simulation::partLost: through a fixture, left the feeder...) and kept in the
+  /// simulation, before the exit: its measurement (drift, exit) ended there, so a tunnelled part
+  /// that later falls across the exit plane is not an exit.
+  int lost_before_exit = 0;
   /// Exit orientation histogram, indexed by UpAxis: the body axis pointing up at the crossing.
   std::array<int, kUpAxisCount> up_axis{};
   /// False for spheres: a sphere has no distinguishable axis, the histogram then only records
@@ -133,12 +137,18 @@ struct RunMetrics {
   /// series covers the whole run.
   double warmup = 0;
   /// Mean drift (m/s along d, or rad/s about the axis) over [warmup, end]: total displacement of
-  /// the measured parts divided by time, averaged over parts.
+  /// the measured parts divided by time, averaged over parts. Parts counted lost
+  /// (Simulation::partLost) are left out: a tunnelled or fallen part's motion is not the
+  /// feeder's.
   double mean_drift = 0;
   /// 95 % CI half-width over parts (the drift's unit); 0 with fewer than two parts, where it is
   /// not defined (the outputs write null, an empty field or n/a).
   double mean_drift_ci95 = 0;
-  double vertical_displacement = 0;  ///< mean z change of the parts since they spawned (m)
+  /// Parts whose drift entered mean_drift (not lost, and measured over some time after the
+  /// warm-up before they left or were removed). 0: no mean drift (0 here; the outputs write null
+  /// or n/a), and with fewer than two no confidence interval.
+  int drift_parts = 0;
+  double vertical_displacement = 0;  ///< mean z change of the parts not lost since they spawned (m)
   double throughput = 0;             ///< parts per second through the exit plane (after warmup)
   int parts = 0;                     ///< spawned parts
   double cpu_seconds = 0;            ///< process CPU time of the run

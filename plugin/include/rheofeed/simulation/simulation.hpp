@@ -35,7 +35,9 @@ struct ContactTotals {
 /// One part counted by RunHealth as lost or sunk: which, when, where and how.
 struct PartEvent {
   int part = -1;        ///< the part's index (spawn order)
-  double time = 0;      ///< simulated time of the step that found it (s)
+  double time = 0;      ///< simulated time of the step that found it (s); for "inside_fixture":
+                        ///< the step it went into the fixture it is in (position and velocity
+                        ///< are its state now)
   std::string kind;     ///< the count it went to: "through_fixture", "sunk", "left_feeder",
                         ///< "fell", "out_of_bounds", "nonfinite" or "too_fast"; or
                         ///< "inside_fixture" (RunHealth::inside_fixture_now)
@@ -111,7 +113,8 @@ struct RunHealth {
   /// out on another side, or into it and then out of the scene. They stay in the simulation
   /// until they leave it; each part is counted once. Parts beyond the exit plane are not checked
   /// (they are out of the measurement), except one that crossed it inside a fixture: it is
-  /// followed until it comes out, and counted as any other.
+  /// followed until it comes out, which ends its being inside (parts_inside_fixture) and is not
+  /// counted.
   int parts_through_fixture = 0;
   /// Parts that left the feeder without crossing the exit plane: over a wall, a rim or a side,
   /// onto a catch floor or into the air beyond the feeder's footprint (rule above). Kept in
@@ -366,6 +369,11 @@ class Simulation {
   virtual Method method() const = 0;
   /// What the run lost, could not trust or ignored so far.
   virtual const RunHealth& health() const = 0;
+  /// Whether part `index` (0 <= index < numParts()) has been counted lost (RunHealth: through a
+  /// fixture, left the feeder, fell, out of bounds, non-finite, too fast), whether or not it is
+  /// still in the simulation. Not for a part that only sank and came back, nor for one inside a
+  /// fixture now (a gauge: it may still come out).
+  virtual bool partLost(int index) const = 0;
   /// Switches stage timing on or off (off at construction); switching it on again keeps the
   /// sums. Timing reads the clock a few times per step and per touching geom pair; it does
   /// not change the results (the same part states, bit for bit).
