@@ -59,6 +59,7 @@ ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders, const Setti
 
 ContactCollider::~ContactCollider() {
   if (ray_) dGeomDestroy(ray_);
+  if (pass_ray_) dGeomDestroy(pass_ray_);
   for (dGeomID p : proxies_) dGeomDestroy(p);
   dJointGroupDestroy(group_);
 }
@@ -106,6 +107,7 @@ void ContactCollider::collide(dSpaceID space, double time, double step) {
                    [](const RestingPoint& x, const RestingPoint& y) {
                      return pairBefore(x.part, x.fixture, y.part, y.fixture);
                    });
+  if (settings_.clamp_passes) recordBodies(space);
   const bool speculative = settings_.speculative && step > 0;
   if (speculative) {
     try {
@@ -685,6 +687,88 @@ void ContactCollider::castSweeps(double step) {
       if (n > 0) addContacts(geom, other, contacts.data(), n, gap_speed);
     }
   }
+}
+
+void ContactCollider::recordBodies(dSpaceID space) {
+  bodies_before_.clear();
+  static_geoms_.clear();
+  if (space == nullptr) return;
+  std::vector<dSpaceID> spaces{space};
+  while (!spaces.empty()) {
+    const dSpaceID sp = spaces.back();
+    spaces.pop_back();
+    const int count = dSpaceGetNumGeoms(sp);
+    for (int i = 0; i < count; ++i) {
+      const dGeomID g = dSpaceGetGeom(sp, i);
+      if (dGeomIsSpace(g)) {
+        spaces.push_back(reinterpret_cast<dSpaceID>(g));
+        continue;
+      }
+      const dBodyID b = dGeomGetBody(g);
+      if (!b) {
+        if (dGeomIsEnabled(g)) static_geoms_.push_back(g);
+      } else if (dBodyIsEnabled(b) && !dBodyIsKinematic(b) &&
+                 (bodies_before_.empty() || bodies_before_.back().body != b)) {
+        const dReal* c = dBodyGetPosition(b);
+        const dReal* q = dBodyGetQuaternion(b);
+        // A centre that moves less than this cannot have crossed a fixture from outside it
+        // (it starts at least the geom's smallest half extent from any surface it rests on).
+        bodies_before_.push_back({b,
+                                  {c[0], c[1], c[2]},
+                                  {q[0], q[1], q[2], q[3]},
+                                  settings_.speculative_fraction * smallestHalfExtent(g)});
+      }
+    }
+  }
+}
+
+std::vector<ContactCollider::ThroughPass> ContactCollider::stopPassesThroughStaticGeoms() {
+  std::vector<ThroughPass> passes;
+  if (!settings_.clamp_passes || static_geoms_.empty()) return passes;
+  if (!pass_ray_) {
+    pass_ray_ = dCreateRay(nullptr, 1);
+    dGeomRaySetClosestHit(pass_ray_, 1);
+  }
+  const auto cast = [this](const Vec3& from, const Vec3& dir, double length, dGeomID g,
+                           dContactGeom* hit) {
+    dGeomRaySetLength(pass_ray_, length);
+    dGeomRaySet(pass_ray_, from.x, from.y, from.z, dir.x, dir.y, dir.z);
+    return dCollide(pass_ray_, g, 1, hit, sizeof *hit) > 0;
+  };
+  for (const BodyBefore& before : bodies_before_) {
+    const dReal* c = dBodyGetPosition(before.body);
+    const Vec3 to{c[0], c[1], c[2]};
+    const Vec3 d = to - before.centre;
+    const double length = norm(d);
+    if (!(length > before.min_travel) || !isFinite(to)) continue;
+    const Vec3 u = (1.0 / length) * d;
+    for (dGeomID g : static_geoms_) {
+      dContactGeom in, out;
+      if (!cast(before.centre, u, length, g, &in)) continue;
+      if (!cast(to, -1.0 * u, length, g, &out)) continue;
+      // In and out within the step; crossings within a micrometre are one surface (a ray
+      // grazing an edge), not a pass.
+      if (!(in.depth + out.depth < length - 1e-6)) continue;
+      Vec3 n{in.normal[0], in.normal[1], in.normal[2]};
+      if (dot(n, u) > 0) n = -1.0 * n;  // out of the geom, against the motion
+      ThroughPass p;
+      p.body = before.body;
+      p.geom = g;
+      p.from = before.centre;
+      p.to = to;
+      p.normal = n;
+      passes.push_back(p);
+      dBodySetPosition(before.body, before.centre.x, before.centre.y, before.centre.z);
+      dBodySetQuaternion(before.body, before.orientation);
+      const dReal* v = dBodyGetLinearVel(before.body);
+      Vec3 vel{v[0], v[1], v[2]};
+      const double into = dot(vel, n);
+      if (into < 0) vel = vel - into * n;
+      dBodySetLinearVel(before.body, vel.x, vel.y, vel.z);
+      break;  // put back: no other geom to test
+    }
+  }
+  return passes;
 }
 
 }  // namespace rheofeed

@@ -52,6 +52,18 @@
 /// lie across a gap become speculative contacts (the gap as above). They are counted
 /// (restingContactCount).
 ///
+/// ## Passes stopped
+/// Speculative contacts see a body's velocity before the solve. A part struck by another within
+/// the step (a crowd landing: a box knocked down at 1-2 m/s, spinning at 200 rad/s) gets its
+/// speed from the solve and can cross a thin fixture (a 2 mm floor) in one step, with no contact
+/// to stop it. With Settings::clamp_passes, collide() records each dynamic body's centre of mass,
+/// and stopPassesThroughStaticGeoms(), called after the step, finds the bodies whose centre went
+/// in through a static geom's surface and out through another within the step (ODE rays, both
+/// ways; a single open sheet has no inside and is not tested this way), puts each back where it
+/// was before the step (centre and orientation), with the velocity into the entry surface
+/// removed: an inelastic stop at the surface, one step early. A centre that ends inside the geom is not moved (the contacts
+/// push it out; the run counts it as sunk if it went deep). The caller counts the passes.
+///
 /// ## Warm start
 /// ODE's quickstep starts every row from zero, so a heap's weight is rebuilt from nothing each
 /// step, one layer per Gauss-Seidel sweep, and stays short of it at a fixed iteration count.
@@ -139,6 +151,10 @@ class ContactCollider {
     /// swept (finite, > 0); 0.25 catches a part well before it can pass through anything as
     /// thick as itself.
     double speculative_fraction = 0.25;
+    /// Passes stopped (file comment): collide() records every body's centre, and
+    /// stopPassesThroughStaticGeoms() puts back a body whose centre passed through a static
+    /// geom in the step. Off by default.
+    bool clamp_passes = false;
     /// Warm start (file comment): each contact starts from the force (N) of the previous
     /// step's contact of the same geom pair nearest to its point, within warm_start_distance.
     /// Needs the patched ODE (odeHasContactWarmStart()) and dWorldQuickStep on one thread;
@@ -217,6 +233,23 @@ class ContactCollider {
   int restingContactCount() const { return resting_count_; }
   /// Of those, the ones that started from a previous contact's force (Settings::warm_start).
   int warmStartedContactCount() const { return warm_started_count_; }
+
+  /// A body whose centre of mass passed through a static geom (no body: a fixture) in the step
+  /// just taken: it went in through a surface and out through another within the step.
+  struct ThroughPass {
+    dBodyID body = nullptr;
+    dGeomID geom = nullptr;  ///< the static geom it passed through
+    Vec3 from, to;           ///< its centre before and after the step (m, world)
+    Vec3 normal;             ///< the entry surface's normal, out of the geom (world)
+  };
+  /// Settings::clamp_passes (file comment, "Passes stopped"): after dWorldStep or
+  /// dWorldQuickStep, finds every body of the last collide()'s space whose centre passed
+  /// through a static geom in the step (a ray from its centre before the step, recorded by
+  /// collide(), to its centre now, in through one surface and out through another), puts it
+  /// back where it was before the step (centre and orientation) and removes its velocity into
+  /// the entry surface (v -= min(0, v . n) n). Returns the passes it stopped (empty when off). Call it once per
+  /// step, before anything moves the bodies again.
+  std::vector<ThroughPass> stopPassesThroughStaticGeoms();
   const std::vector<Joint>& joints() const { return joints_; }
   dJointGroupID jointGroup() const { return group_; }
 
@@ -271,6 +304,18 @@ class ContactCollider {
     std::vector<dGeomID> touching;  // geoms the regular pass gave it contacts with
   };
   std::vector<Sweep> sweeps_;
+  // Settings::clamp_passes: the dynamic bodies of the last collide()'s space and their centres
+  // before the step; the space's static geoms.
+  struct BodyBefore {
+    dBodyID body;
+    Vec3 centre;
+    dQuaternion orientation;
+    double min_travel;  // m: a centre moving less is not tested
+  };
+  std::vector<BodyBefore> bodies_before_;
+  std::vector<dGeomID> static_geoms_;
+  dGeomID pass_ray_ = nullptr;  // no backface culling: a pass leaves through a back face
+  void recordBodies(dSpaceID space);
   std::unordered_map<dGeomID, std::size_t> sweep_of_proxy_, sweep_of_geom_;
   std::vector<dGeomID> proxies_;
   dGeomID ray_ = nullptr;

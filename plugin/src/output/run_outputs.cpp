@@ -69,14 +69,14 @@ std::string summaryJson(const RunMetrics& r) {
       "\"friction_dropped_contacts\": %ld, \"gyroscopic_fallback_steps\": %ld, "
       "\"max_part_speed_mps\": %.6g, \"speed_bound_mps\": %.6g, "
       "\"max_physical_speed_ratio\": %.6g, \"speculative_contacts\": %ld, "
-      "\"warm_started_contacts\": %ld, \"ignored_settings\": [",
+      "\"warm_started_contacts\": %ld, \"passes_stopped\": %ld, \"ignored_settings\": [",
       h.steps, h.parts_exited, h.partsLost(), h.parts_fell, h.parts_through_fixture,
       h.parts_out_of_bounds, h.parts_nonfinite, h.parts_too_fast, h.parts_inside_fixture,
       h.parts_left_feeder, h.parts_sunk, h.coulomb_fallback_steps,
       h.steps > 0 ? double(h.coulomb_fallback_steps) / h.steps : 0.0, h.solver_unconverged_steps,
       h.ipm_second_solve_steps, h.ipm_converged_steps, h.ipm_not_run_steps,
       h.friction_dropped_contacts, h.gyroscopic_fallback_steps, h.max_part_speed, h.speed_bound,
-      h.max_speed_ratio, h.speculative_contacts, h.warm_started_contacts);
+      h.max_speed_ratio, h.speculative_contacts, h.warm_started_contacts, h.passes_stopped);
   std::string json = "{\"scene\": " + jsonQuoted(r.scene) + run + c;
   for (std::size_t k = 0; k < h.ignored_settings.size(); ++k) {
     json += (k ? ", " : "") + jsonQuoted(h.ignored_settings[k]);

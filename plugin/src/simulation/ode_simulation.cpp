@@ -8,6 +8,7 @@
 // and swaps it in around its collide + step only (simulation.hpp, makeSimulation).
 #include <ode/ode.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -79,6 +80,7 @@ class OdeSimulation final : public PartSimulation {
     cs.feedback = true;
     cs.friction = friction;
     cs.speculative = scene.solver.speculative_contacts.value_or(true);
+    cs.clamp_passes = cs.speculative;
     cs.warm_start = odeWarmStartsContacts(scene);
     collider_ = std::make_unique<ContactCollider>(world_, *feeders_, cs);
     const double mu = scene.material.mu, bounce = scene.material.restitution;
@@ -139,6 +141,18 @@ class OdeSimulation final : public PartSimulation {
     }
     random_state_ = dRandGetSeed();
     dRandSetSeed(outside);
+    for (const ContactCollider::ThroughPass& p : collider_->stopPassesThroughStaticGeoms()) {
+      ++health_.passes_stopped;
+      if (health_.passes_stopped == 1) {
+        const auto it = std::find(parts_.begin(), parts_.end(), p.body);
+        std::ostringstream line;
+        line << "part " << (it - parts_.begin()) << "'s centre passed through a fixture within "
+             << "the step to t = " << t + h << " s, from " << formatPosition(p.from) << " to "
+             << formatPosition(p.to) << ": put back where it was, its velocity into the "
+             << "fixture removed (a part struck by another during the solve; all are counted)";
+        reportFirst("stopped pass", line.str());
+      }
+    }
     if (timing) {
       times.contact_count += collider_->contactCount();
       times.constraint_rows += long(collider_->contactCount()) * rows_per_contact_;

@@ -118,6 +118,11 @@ std::string healthSummary(const RunHealth& h, int parts) {
       << "point it is followed by lies in its material) and came back";
     separator = "; ";
   }
+  if (h.passes_stopped > 0) {
+    s << separator << h.passes_stopped << (h.passes_stopped == 1 ? " part" : " parts")
+      << " passed through a fixture within a step and were put back (not lost)";
+    separator = "; ";
+  }
   if (h.coulomb_fallback_steps > 0) {
     s << separator << h.coulomb_fallback_steps << " of " << h.steps << " steps used the Coulomb "
       << "fallback (" << 100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps) << " %)";

@@ -188,6 +188,12 @@ struct RunHealth {
   /// across a gap over the run (summed over steps; 0 when off and for the reference engine).
   /// Informative, not a loss.
   long speculative_contacts = 0;
+  /// ODE runs with speculative contacts: parts whose centre passed through a fixture within a
+  /// step (struck by another part during the solve, faster than their sweep before it) and
+  /// were put back where they were before the step, their velocity into the fixture removed
+  /// (ContactCollider::stopPassesThroughStaticGeoms; summed over steps). Not a loss: the part
+  /// stays on the side it came from, one step late. The first is named on stderr.
+  long passes_stopped = 0;
   /// ODE runs with warm starts (SolverSettings::warm_start): contacts whose solve started from
   /// the previous step's force of the same contact (summed over steps; 0 when off and for the
   /// reference engine). Informative.
@@ -209,7 +215,7 @@ struct RunHealth {
   }
   /// Whether anything was lost, not trusted or ignored.
   bool anything() const {
-    return partsLost() > 0 || parts_sunk > 0 || coulomb_fallback_steps > 0 ||
+    return partsLost() > 0 || parts_sunk > 0 || passes_stopped > 0 || coulomb_fallback_steps > 0 ||
            solver_unconverged_steps > 0 || friction_dropped_contacts > 0 ||
            gyroscopic_fallback_steps > 0 || !ignored_settings.empty();
   }
