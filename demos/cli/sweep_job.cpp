@@ -377,6 +377,7 @@ Manifest readManifest(const Folder& folder) {
 const std::vector<std::string>& healthKeys() {
   static const std::vector<std::string> keys = {"parts_lost",
                                                 "parts_sunk",
+                                                "passes_stopped",
                                                 "coulomb_fallback_steps",
                                                 "solver_unconverged_steps",
                                                 "friction_dropped_contacts",

@@ -724,50 +724,81 @@ void ContactCollider::recordBodies(dSpaceID space) {
 
 std::vector<ContactCollider::ThroughPass> ContactCollider::stopPassesThroughStaticGeoms() {
   std::vector<ThroughPass> passes;
-  if (!settings_.clamp_passes || static_geoms_.empty()) return passes;
-  if (!pass_ray_) {
-    pass_ray_ = dCreateRay(nullptr, 1);
-    dGeomRaySetClosestHit(pass_ray_, 1);
-  }
-  const auto cast = [this](const Vec3& from, const Vec3& dir, double length, dGeomID g,
-                           dContactGeom* hit) {
-    dGeomRaySetLength(pass_ray_, length);
-    dGeomRaySet(pass_ray_, from.x, from.y, from.z, dir.x, dir.y, dir.z);
-    return dCollide(pass_ray_, g, 1, hit, sizeof *hit) > 0;
-  };
-  for (const BodyBefore& before : bodies_before_) {
-    const dReal* c = dBodyGetPosition(before.body);
-    const Vec3 to{c[0], c[1], c[2]};
-    const Vec3 d = to - before.centre;
-    const double length = norm(d);
-    if (!(length > before.min_travel) || !isFinite(to)) continue;
-    const Vec3 u = (1.0 / length) * d;
-    for (dGeomID g : static_geoms_) {
-      dContactGeom in, out;
-      if (!cast(before.centre, u, length, g, &in)) continue;
-      if (!cast(to, -1.0 * u, length, g, &out)) continue;
-      // In and out within the step; crossings within a micrometre are one surface (a ray
-      // grazing an edge), not a pass.
-      if (!(in.depth + out.depth < length - 1e-6)) continue;
-      Vec3 n{in.normal[0], in.normal[1], in.normal[2]};
-      if (dot(n, u) > 0) n = -1.0 * n;  // out of the geom, against the motion
-      ThroughPass p;
-      p.body = before.body;
-      p.geom = g;
-      p.from = before.centre;
-      p.to = to;
-      p.normal = n;
-      passes.push_back(p);
-      dBodySetPosition(before.body, before.centre.x, before.centre.y, before.centre.z);
-      dBodySetQuaternion(before.body, before.orientation);
-      const dReal* v = dBodyGetLinearVel(before.body);
-      Vec3 vel{v[0], v[1], v[2]};
-      const double into = dot(vel, n);
-      if (into < 0) vel = vel - into * n;
-      dBodySetLinearVel(before.body, vel.x, vel.y, vel.z);
-      break;  // put back: no other geom to test
+  std::vector<dBodyID> stopped;  // this step's, for the next call's no-repeat rule
+  if (settings_.clamp_passes && !static_geoms_.empty()) {
+    if (!pass_ray_) {
+      pass_ray_ = dCreateRay(nullptr, 1);
+      dGeomRaySetClosestHit(pass_ray_, 1);
+    }
+    const auto cast = [this](const Vec3& from, const Vec3& dir, double length, dGeomID g,
+                             dContactGeom* hit) {
+      dGeomRaySetLength(pass_ray_, length);
+      dGeomRaySet(pass_ray_, from.x, from.y, from.z, dir.x, dir.y, dir.z);
+      return dCollide(pass_ray_, g, 1, hit, sizeof *hit) > 0;
+    };
+    for (const BodyBefore& before : bodies_before_) {
+      // A body stopped in the previous step is not stopped again: the stop gave it back its
+      // pre-step state, so a second pass would repeat for ever and freeze it. The pass stands,
+      // and the caller's own checks count it.
+      if (std::find(stopped_last_.begin(), stopped_last_.end(), before.body) !=
+          stopped_last_.end()) {
+        continue;
+      }
+      const dReal* c = dBodyGetPosition(before.body);
+      const Vec3 to{c[0], c[1], c[2]};
+      const Vec3 d = to - before.centre;
+      const double length = norm(d);
+      if (!(length > before.min_travel) || !isFinite(to)) continue;
+      const Vec3 u = (1.0 / length) * d;
+      dReal seg[6];  // the segment's bounding box, to skip geoms it cannot reach
+      for (int k = 0; k < 3; ++k) {
+        const double a = k == 0 ? before.centre.x : k == 1 ? before.centre.y : before.centre.z;
+        const double b = k == 0 ? to.x : k == 1 ? to.y : to.z;
+        seg[2 * k] = std::min(a, b);
+        seg[2 * k + 1] = std::max(a, b);
+      }
+      for (dGeomID g : static_geoms_) {
+        if (dGeomGetClass(g) != dPlaneClass) {  // a plane's box is infinite, and it has no far side
+          dReal box[6];
+          dGeomGetAABB(g, box);
+          if (seg[1] < box[0] || seg[0] > box[1] || seg[3] < box[2] || seg[2] > box[3] ||
+              seg[5] < box[4] || seg[4] > box[5]) {
+            continue;
+          }
+        }
+        dContactGeom in, out;
+        if (!cast(before.centre, u, length, g, &in)) continue;
+        if (!cast(to, -1.0 * u, length, g, &out)) continue;
+        // In and out within the step; crossings within a micrometre are one surface (a ray
+        // grazing an edge), not a pass.
+        if (!(in.depth + out.depth < length - 1e-6)) continue;
+        Vec3 n{in.normal[0], in.normal[1], in.normal[2]};
+        if (dot(n, u) > 0) n = -1.0 * n;  // out of the geom, against the motion
+        ThroughPass p;
+        p.body = before.body;
+        p.geom = g;
+        p.from = before.centre;
+        p.to = to;
+        p.normal = n;
+        passes.push_back(p);
+        stopped.push_back(before.body);
+        // Back to the pre-step pose, stopped against the surface: the velocity into it and the
+        // spin (which would turn the part into it again) removed.
+        dBodySetPosition(before.body, before.centre.x, before.centre.y, before.centre.z);
+        dBodySetQuaternion(before.body, before.orientation);
+        const dReal* v = dBodyGetLinearVel(before.body);
+        Vec3 vel{v[0], v[1], v[2]};
+        const double into = dot(vel, n);
+        if (into < 0) vel = vel - into * n;
+        dBodySetLinearVel(before.body, vel.x, vel.y, vel.z);
+        dBodySetAngularVel(before.body, 0, 0, 0);
+        break;  // put back: no other geom to test
+      }
     }
   }
+  // The records are this step's only: a second call, or a step without collide(), finds none.
+  bodies_before_.clear();
+  stopped_last_ = std::move(stopped);
   return passes;
 }
 

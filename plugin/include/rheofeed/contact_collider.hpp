@@ -56,13 +56,20 @@
 /// Speculative contacts see a body's velocity before the solve. A part struck by another within
 /// the step (a crowd landing: a box knocked down at 1-2 m/s, spinning at 200 rad/s) gets its
 /// speed from the solve and can cross a thin fixture (a 2 mm floor) in one step, with no contact
-/// to stop it. With Settings::clamp_passes, collide() records each dynamic body's centre of mass,
-/// and stopPassesThroughStaticGeoms(), called after the step, finds the bodies whose centre went
-/// in through a static geom's surface and out through another within the step (ODE rays, both
-/// ways; a single open sheet has no inside and is not tested this way), puts each back where it
-/// was before the step (centre and orientation), with the velocity into the entry surface
-/// removed: an inelastic stop at the surface, one step early. A centre that ends inside the geom is not moved (the contacts
-/// push it out; the run counts it as sunk if it went deep). The caller counts the passes.
+/// to stop it. With Settings::clamp_passes, collide() records each dynamic body's centre of mass
+/// and orientation, and stopPassesThroughStaticGeoms(), called after the step, finds the bodies
+/// whose centre went in through a static geom's surface and out through another within the step
+/// (ODE rays, both ways), puts each back where it was before the step, with the velocity into the
+/// entry surface and the spin removed: an inelastic stop at the surface, one step early. A body
+/// stopped in one step is not stopped in the next (its state was put back, so the pass could
+/// repeat for ever): that pass stands, for the caller's own checks to count. The caller counts
+/// the stops. Limits: only static geoms (no body) are tested, so a vibrating fixture of a
+/// full-vibration run (a kinematic body) is not; a single open sheet (a mesh with no inside), a
+/// centre that ends inside the geom (left to the contacts), a pass through another part, and a
+/// body's centre of mass lying outside its material (a ring around a bar) are not told apart
+/// from the geom's inside; geom category and collide bits and the SurfaceCallback are not
+/// consulted; a body whose centre moves less than speculative_fraction times its geom's smallest
+/// half extent in the step is not tested.
 ///
 /// ## Warm start
 /// ODE's quickstep starts every row from zero, so a heap's weight is rebuilt from nothing each
@@ -246,9 +253,11 @@ class ContactCollider {
   /// dWorldQuickStep, finds every body of the last collide()'s space whose centre passed
   /// through a static geom in the step (a ray from its centre before the step, recorded by
   /// collide(), to its centre now, in through one surface and out through another), puts it
-  /// back where it was before the step (centre and orientation) and removes its velocity into
-  /// the entry surface (v -= min(0, v . n) n). Returns the passes it stopped (empty when off). Call it once per
-  /// step, before anything moves the bodies again.
+  /// back where it was before the step (centre and orientation), removes its velocity into the
+  /// entry surface (v -= min(0, v . n) n) and its spin, unless it was stopped by the previous
+  /// call. Returns the passes it stopped (empty when off). Call it once per step, after the step
+  /// and before anything moves the bodies again; it uses the records of the last collide() once
+  /// (a second call finds none). Bodies must not be destroyed between collide() and this call.
   std::vector<ThroughPass> stopPassesThroughStaticGeoms();
   const std::vector<Joint>& joints() const { return joints_; }
   dJointGroupID jointGroup() const { return group_; }
@@ -313,6 +322,7 @@ class ContactCollider {
     double min_travel;  // m: a centre moving less is not tested
   };
   std::vector<BodyBefore> bodies_before_;
+  std::vector<dBodyID> stopped_last_;  // bodies stopped by the previous call (not again)
   std::vector<dGeomID> static_geoms_;
   dGeomID pass_ray_ = nullptr;  // no backface culling: a pass leaves through a back face
   void recordBodies(dSpaceID space);

@@ -149,7 +149,8 @@ class OdeSimulation final : public PartSimulation {
         line << "part " << (it - parts_.begin()) << "'s centre passed through a fixture within "
              << "the step to t = " << t + h << " s, from " << formatPosition(p.from) << " to "
              << formatPosition(p.to) << ": put back where it was, its velocity into the "
-             << "fixture removed (a part struck by another during the solve; all are counted)";
+             << "fixture and its spin removed (not lost; a part stopped in one step is not "
+             << "stopped in the next)";
         reportFirst("stopped pass", line.str());
       }
     }

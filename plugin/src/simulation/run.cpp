@@ -119,8 +119,8 @@ std::string healthSummary(const RunHealth& h, int parts) {
     separator = "; ";
   }
   if (h.passes_stopped > 0) {
-    s << separator << h.passes_stopped << (h.passes_stopped == 1 ? " part" : " parts")
-      << " passed through a fixture within a step and were put back (not lost)";
+    s << separator << h.passes_stopped << (h.passes_stopped == 1 ? " pass" : " passes")
+      << " through a fixture within a step stopped, the part put back (not lost)";
     separator = "; ";
   }
   if (h.coulomb_fallback_steps > 0) {

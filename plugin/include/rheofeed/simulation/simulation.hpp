@@ -188,11 +188,12 @@ struct RunHealth {
   /// across a gap over the run (summed over steps; 0 when off and for the reference engine).
   /// Informative, not a loss.
   long speculative_contacts = 0;
-  /// ODE runs with speculative contacts: parts whose centre passed through a fixture within a
-  /// step (struck by another part during the solve, faster than their sweep before it) and
-  /// were put back where they were before the step, their velocity into the fixture removed
-  /// (ContactCollider::stopPassesThroughStaticGeoms; summed over steps). Not a loss: the part
-  /// stays on the side it came from, one step late. The first is named on stderr.
+  /// ODE runs with speculative contacts: passes of a part's centre through a static fixture
+  /// within a step (a part struck by another during the solve, faster than its sweep before it)
+  /// that were stopped: the part put back where it was before the step, its velocity into the
+  /// fixture and its spin removed (ContactCollider::stopPassesThroughStaticGeoms; summed over
+  /// steps; a part stopped in one step is not stopped in the next, and that pass is counted as
+  /// any other). Not a loss. The first is named on stderr.
   long passes_stopped = 0;
   /// ODE runs with warm starts (SolverSettings::warm_start): contacts whose solve started from
   /// the previous step's force of the same contact (summed over steps; 0 when off and for the
