@@ -750,19 +750,17 @@ std::vector<ContactCollider::ThroughPass> ContactCollider::stopPassesThroughStat
       const double length = norm(d);
       if (!(length > before.min_travel) || !isFinite(to)) continue;
       const Vec3 u = (1.0 / length) * d;
-      dReal seg[6];  // the segment's bounding box, to skip geoms it cannot reach
-      for (int k = 0; k < 3; ++k) {
-        const double a = k == 0 ? before.centre.x : k == 1 ? before.centre.y : before.centre.z;
-        const double b = k == 0 ? to.x : k == 1 ? to.y : to.z;
-        seg[2 * k] = std::min(a, b);
-        seg[2 * k + 1] = std::max(a, b);
-      }
+      // The segment's bounding box, to skip geoms it cannot reach.
+      const Vec3 lo{std::min(before.centre.x, to.x), std::min(before.centre.y, to.y),
+                    std::min(before.centre.z, to.z)};
+      const Vec3 hi{std::max(before.centre.x, to.x), std::max(before.centre.y, to.y),
+                    std::max(before.centre.z, to.z)};
       for (dGeomID g : static_geoms_) {
         if (dGeomGetClass(g) != dPlaneClass) {  // a plane's box is infinite, and it has no far side
           dReal box[6];
           dGeomGetAABB(g, box);
-          if (seg[1] < box[0] || seg[0] > box[1] || seg[3] < box[2] || seg[2] > box[3] ||
-              seg[5] < box[4] || seg[4] > box[5]) {
+          if (hi.x < box[0] || lo.x > box[1] || hi.y < box[2] || lo.y > box[3] || hi.z < box[4] ||
+              lo.z > box[5]) {
             continue;
           }
         }

@@ -253,7 +253,7 @@ TEST(RunHealth, PartInsideAFixtureNowIsListedWithWhenItWentIn) {
     EXPECT_EQ(e.kind, "inside_fixture");
     EXPECT_EQ(e.fixture, "floor");
     EXPECT_EQ(e.part, 0);
-    EXPECT_DOUBLE_EQ(e.time, kStep);
+    EXPECT_DOUBLE_EQ(e.time, kStep);       // simulated time of step 1, not a clock
     EXPECT_NEAR(e.position.z, z1, 1e-12);  // free flight in step 1: semi-implicit Euler
     EXPECT_NEAR(e.velocity.z, -(kThrowSpeed + kGravity * kStep), 1e-12);
     EXPECT_TRUE(h.part_events.empty());  // not counted otherwise (yet)
