@@ -88,15 +88,20 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
                            : std::string()) +
       (args.warmup_given ? " with --warmup " + formatNumber(args.warmup) + " s" : std::string()) +
       (args.dt_given ? " with --dt " + formatNumber(args.dt) + " s" : std::string());
+  StepOverrides overrides;
+  if (args.dt_given) overrides.every_run = args.dt;
   try {
-    // With --dt every run steps with it: the scene's duration and step limits are checked
-    // against it, not against steps the runs will not take.
-    Scene checked = scene;
-    if (args.dt_given) {
-      checked.solver.time_step = args.dt;
-      checked.solver.rheonomic_time_step = 0;
+    // What does not depend on the run is checked once here, at the coarsest step a planned run
+    // takes (as that run will see the scene: atRunStep), not at steps no run takes: a rheonomic
+    // run's --duration is not refused for what it would cost at the full-vibration step, nor a
+    // --dt above the sample interval (the run samples once per step and says so below). Each
+    // run is then checked at its own step, with its method named.
+    RunStep coarsest = runStep(scene, Method::OdeFullVibration, overrides);  // no method: its own
+    if (!methods.empty()) coarsest = runStep(scene, methods.front(), overrides);
+    for (Method m : methods) {
+      if (RunStep s = runStep(scene, m, overrides); s.time_step > coarsest.time_step) coarsest = s;
     }
-    checked.validate();
+    atRunStep(scene, coarsest).validate();
   } catch (const std::invalid_argument& e) {
     std::string hint;
     if (args.duration_given && !args.warmup_given &&
@@ -109,8 +114,6 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
   for (Method m : methods) {
     PlannedRun run;
     run.method = m;
-    StepOverrides overrides;
-    if (args.dt_given) overrides.every_run = args.dt;
     const RunStep step = runStep(scene, m, overrides);
     const double h = step.time_step;
     run.step_source = step.source();

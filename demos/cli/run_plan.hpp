@@ -61,9 +61,11 @@ rheofeed::scene::DriftModel parseDriftModelOption(const std::string& name);
 rheofeed::scene::Method parseMethod(const std::string& name);
 
 /// Checks the overrides, loads the scene and builds every run (the step rule above; the sample
-/// interval is raised to the step where it is shorter). `default_methods` are used when
-/// args.methods is empty. Throws std::invalid_argument naming the value, where it came from and
-/// the allowed range (the scene loader's SceneFileError for a bad file).
+/// interval is raised to the step where it is shorter). The scene's limits that do not depend on
+/// the run are checked at the coarsest planned step, and each run's scene at its own step (a
+/// step-count limit only a finer run breaks names that run's method). `default_methods` are used
+/// when args.methods is empty. Throws std::invalid_argument naming the value, where it came from
+/// and the allowed range (the scene loader's SceneFileError for a bad file).
 Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_methods);
 
 /// Creates `folder` (and its parents) and checks that a file can be written in it. Throws
