@@ -2,16 +2,46 @@
 // Calibrating what a scene's rheonomic runs need (calibration.hpp: calibrateScene), shared by
 // `rheofeed run` (calibrates what the scene does not give, every launch) and `rheofeed
 // calibrate` (calibrates once and writes the result into a copy of the scene).
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
 #include "rheofeed/measure/calibration.hpp"
+#include "rheofeed/number_format.hpp"
 
 namespace rheofeed::scene {
+
+namespace {
+
+// The message of CalibrateReport::imprecise for a calibration of `what` = value +- ci95 (95 %),
+// or "" when it is precise enough. A sampling run's interval narrows about as one over the
+// square root of the cycles it measures where the parts' own fluctuation limits it (not where a
+// few sampled parts differ for good, e.g. nuts lying flat and on edge).
+std::string imprecision(const std::string& what, double value, double ci95,
+                        const CalibrateOptions& options) {
+  const double relative = value != 0 ? std::abs(ci95 / value) : HUGE_VAL;
+  if (!(relative > kImpreciseCalibration)) return "";
+  std::ostringstream m;
+  m << what << " is known to +-" << std::lround(100 * relative) << " % (95 %), above "
+    << std::lround(100 * kImpreciseCalibration)
+    << " %: the runs that use it carry that uncertainty; more measured cycles narrow it "
+       "(--measure-cycles "
+    << formatNumber(options.measure_cycles)
+    << " now; four times as many about halve it where the parts' motion over time, not the "
+       "few parts sampled, limits it)";
+  return m.str();
+}
+
+}  // namespace
 
 CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
                                const std::string& label, std::FILE* log) {
   CalibrateReport report;
+  const auto note_imprecision = [&](const std::string& message) {
+    if (message.empty()) return;
+    std::fprintf(log, "%s: warning: %s\n", label.c_str(), message.c_str());
+    report.imprecise.push_back(message);
+  };
   for (std::size_t i = 0; i < scene.fixtures.size(); ++i) {
     const FeederLaw law = scene.fixtures[i].law;
     if (law.kind != FeederLaw::Kind::Vibration) continue;
@@ -51,6 +81,11 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
       }
       line << ", " << c.how << ", " << c.cpu_seconds << " s CPU";
       report.cpu_seconds += c.cpu_seconds;
+      if (!options.classical) {  // the classical model has no sampling interval to widen
+        note_imprecision(imprecision("fixture '" + name + "': the calibrated drift " +
+                                         formatNumber(c.value) + " +- " + formatNumber(c.ci95),
+                                     c.value, c.ci95, options));
+      }
       scene = withCalibration(scene, c);
     } else {  // local_sampled: each part family's own efficiency under the local law
       if (options.classical) {
@@ -79,6 +114,10 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
              << "': efficiency " << c.efficiency << " +- " << c.ci95 << " (" << c.how << ", "
              << c.cpu_seconds << " s CPU)";
         report.cpu_seconds += c.cpu_seconds;
+        note_imprecision(imprecision("fixture '" + name + "', part family '" + scene.parts[k].name +
+                                         "': the efficiency " + formatNumber(c.efficiency) +
+                                         " +- " + formatNumber(c.ci95),
+                                     c.efficiency, c.ci95, options));
         sampled = withEfficiency(sampled, c);
       }
       scene = sampled;

@@ -18,6 +18,7 @@
 #include <cstdio>
 
 #include <string>
+#include <vector>
 
 #include "rheofeed/scene/scene.hpp"
 
@@ -139,7 +140,15 @@ struct CalibrateReport {
   int local = 0;       ///< vibrating fixtures on the local law (nothing to calibrate)
   double cpu_seconds = 0;  ///< CPU time of the calibrations (s)
   std::string summary;     ///< one line per calibrated fixture: value, 95 % interval, how
+  /// One message per calibration whose 95 % half-width exceeds kImpreciseCalibration of its
+  /// value (a calibrated drift, or a part family's efficiency): the runs that use it carry that
+  /// uncertainty. Also printed on the log as a warning, with the longer sampling that narrows it.
+  std::vector<std::string> imprecise;
 };
+
+/// A calibration is reported imprecise (CalibrateReport::imprecise) when its 95 % half-width is
+/// above this fraction of its value.
+inline constexpr double kImpreciseCalibration = 0.1;
 
 /// Calibrates the vibrating fixtures of `scene` that need it (all but the local-law ones with
 /// options.force) and stores the results in it: calibrated_drift by calibrateBySampling (or
