@@ -210,6 +210,12 @@ TEST(SummaryJson, ParsesToTheRunMetricsWritten) {
   EXPECT_EQ(l.size(), 7u);  // feeders, contacts, wall_contacts, cells, model runs and CPU, corners
 }
 
+// What a user needs to reproduce a run: the version that wrote it (the CMake project's, passed
+// to this test by its build).
+TEST(SummaryJson, NamesTheVersionThatWroteIt) {
+  EXPECT_EQ(json::parse(summaryJson(run()))["rheofeed_version"], RHEOFEED_PROJECT_VERSION);
+}
+
 // A blown-up part's numbers: null, never "nan" or "inf", which are not JSON.
 TEST(SummaryJson, NonFiniteNumbersAreNull) {
   RunMetrics r = run();

@@ -8,6 +8,7 @@
 #include "rheofeed/measure/statistics.hpp"
 #include "rheofeed/output/output.hpp"
 #include "rheofeed/output/plot.hpp"
+#include "rheofeed/version.hpp"
 
 namespace rheofeed::scene {
 
@@ -101,6 +102,7 @@ OrderedJson localLawJson(const RunHealth& h) {
 std::string summaryJson(const RunMetrics& r) {
   OrderedJson j;
   j["scene"] = r.scene;
+  j["rheofeed_version"] = kVersion;
   j["method"] = toString(r.method);
   j["time_step_s"] = r.time_step;
   j["parts"] = r.parts;
