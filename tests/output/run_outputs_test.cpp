@@ -216,6 +216,14 @@ TEST(SummaryJson, NamesTheVersionThatWroteIt) {
   EXPECT_EQ(json::parse(summaryJson(run()))["rheofeed_version"], RHEOFEED_PROJECT_VERSION);
 }
 
+// The scene file a run read, or "built-in" for a scene built in code.
+TEST(SummaryJson, NamesTheSceneFileOrBuiltIn) {
+  RunMetrics r = run();
+  EXPECT_EQ(json::parse(summaryJson(r))["scene_source"], "built-in");  // no file: built in code
+  r.scene_file = "/data/scenes/trough \"A\".json";
+  EXPECT_EQ(json::parse(summaryJson(r))["scene_source"], r.scene_file);
+}
+
 // A blown-up part's numbers: null, never "nan" or "inf", which are not JSON.
 TEST(SummaryJson, NonFiniteNumbersAreNull) {
   RunMetrics r = run();

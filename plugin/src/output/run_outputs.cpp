@@ -102,6 +102,7 @@ OrderedJson localLawJson(const RunHealth& h) {
 std::string summaryJson(const RunMetrics& r) {
   OrderedJson j;
   j["scene"] = r.scene;
+  j["scene_source"] = r.scene_file.empty() ? std::string("built-in") : r.scene_file;
   j["rheofeed_version"] = kVersion;
   j["method"] = toString(r.method);
   j["time_step_s"] = r.time_step;

@@ -124,7 +124,11 @@ struct FeederMetrics {
 
 /// The result of one run.
 struct RunMetrics {
-  std::string scene;
+  std::string scene;  ///< Scene::name
+  /// The scene file the run's scene was read from (the path as the caller resolved it: a file
+  /// given to `rheofeed run`, or a shipped scene's file); empty for a scene built in code (the
+  /// run JSON then says "built-in"). Filled by the caller of measureRun, which alone knows it.
+  std::string scene_file;
   Method method = Method::OdeRheonomic;
   double time_step = 0;    ///< (s)
   std::uint64_t seed = 0;  ///< Scene::seed of the run (to reproduce it)
