@@ -224,6 +224,37 @@ TEST(SummaryJson, NamesTheSceneFileOrBuiltIn) {
   EXPECT_EQ(json::parse(summaryJson(r))["scene_source"], r.scene_file);
 }
 
+TEST(SummaryJson, SolverHasTheAppliedSettingsAndNullWhereOneDoesNotApply) {
+  RunMetrics r = run();
+  AppliedSolver& a = r.solver;
+  a.engine = "ode";
+  a.mode = "quickstep";
+  a.iterations = 30;
+  a.warm_start = true;
+  a.speculative_contacts = false;
+  a.erp = 0.2;
+  a.cfm = 1e-5;
+  a.max_correcting_velocity = 0.5;
+  a.surface_layer = 1e-4;
+  a.mu = 0.6;
+  a.restitution = 0.1;
+  const json j = json::parse(summaryJson(r))["solver"];
+  EXPECT_EQ(j["engine"], "ode");
+  EXPECT_EQ(j["mode"], "quickstep");
+  EXPECT_EQ(j["iterations"], 30);
+  EXPECT_EQ(j["warm_start"], true);
+  EXPECT_EQ(j["speculative_contacts"], false);
+  EXPECT_EQ(j["erp"], 0.2);  // numbers round-trip exactly
+  EXPECT_EQ(j["cfm"], 1e-5);
+  EXPECT_EQ(j["max_correcting_velocity_mps"], 0.5);
+  EXPECT_EQ(j["surface_layer_m"], 1e-4);
+  EXPECT_EQ(j["surface"], json({{"mu", 0.6}, {"restitution", 0.1}, {"bounce_velocity_mps", 0}}));
+  for (const char* key : {"tolerance", "relaxed_solver", "coulomb_iterations", "ipm_rounds"}) {
+    ASSERT_TRUE(j.contains(key)) << key;  // present (a sweep's metric pointer finds it), null
+    EXPECT_TRUE(j[key].is_null()) << key;
+  }
+}
+
 // A blown-up part's numbers: null, never "nan" or "inf", which are not JSON.
 TEST(SummaryJson, NonFiniteNumbersAreNull) {
   RunMetrics r = run();

@@ -18,6 +18,8 @@
 #include "common/builtin_scenes.hpp"
 #include "rheofeed/measure/metrics.hpp"
 #include "rheofeed/output/output.hpp"
+#include "rheofeed/reference/world.hpp"
+#include "rheofeed/scene/scene_io.hpp"
 #include "rheofeed/simulation/simulation.hpp"
 #include "scene_builders.hpp"
 
@@ -549,6 +551,83 @@ TEST(RunHealth, ReferenceJsonCountsFallbackStepsAsTheWorldReportsThem) {
   EXPECT_LE(r.health.coulomb_fallback_steps, r.health.steps);
   EXPECT_NEAR(h.at("coulomb_fallback_share").get<double>(),
               double(r.health.coulomb_fallback_steps) / r.health.steps, 1e-6);
+}
+
+// The run JSON's "solver" is what the engine applied; here every setting differs from its
+// default, and the expected values are the scene file's own numbers (binary fractions: an ODE
+// built in single precision reads them back exactly).
+constexpr const char* kSolverSceneFile = R"({
+  "format_version": 1,
+  "name": "solver_record",
+  "duration": 0.05,
+  "fixtures": [{"name": "floor", "geoms": [{"shape": "box", "size": [0.5, 0.5, 0.05],
+                                            "position": [0, 0, -0.025]}]}],
+  "parts": [{"name": "cubes", "shape": "box", "count": 1, "density": 1000,
+             "size": [{"mean": 0.02}, {"mean": 0.02}, {"mean": 0.02}],
+             "spawn_min": [0, 0, 0.0105], "spawn_max": [0, 0, 0.0105]}],
+  "material": {"mu": 0.375, "restitution": 0.25},
+  "solver": {"time_step": 0.005, "iterations": 17, "ode_quickstep": true, "erp": 0.375,
+             "cfm": 0.0001220703125, "tolerance": 0.0009765625, "apgd": false,
+             "coulomb_iterations": 0, "max_correcting_velocity": 0.625,
+             "surface_layer": 0.0009765625, "warm_start": false, "speculative_contacts": false},
+  "outputs": {"sample_interval": 0.01}
+})";
+
+TEST(RunHealth, JsonRecordsTheSolverSettingsTheEngineApplied) {
+  const Scene s = parseScene(kSolverSceneFile, "solver_record.json");
+  for (Method m : kRheonomic) {
+    SCOPED_TRACE(toString(m));
+    const nlohmann::json j = nlohmann::json::parse(summaryJson(measureRun(s, m)))["solver"];
+    EXPECT_EQ(j["iterations"], 17);
+    // ODE takes the scene's false; the reference engine always warm-starts its own solves
+    EXPECT_EQ(j["warm_start"], m != Method::OdeRheonomic);
+    EXPECT_EQ(j["erp"], 0.375);
+    EXPECT_EQ(j["cfm"], 0.0001220703125);
+    EXPECT_EQ(j["max_correcting_velocity_mps"], 0.625);
+    EXPECT_EQ(j["surface_layer_m"], 0.0009765625);
+    EXPECT_EQ(j["surface"]["mu"], 0.375);
+    EXPECT_EQ(j["surface"]["restitution"], 0.25);
+    EXPECT_EQ(j["surface"]["bounce_velocity_mps"], 0);
+    if (m == Method::OdeRheonomic) {
+      EXPECT_EQ(j["engine"], "ode");
+      EXPECT_EQ(j["mode"], "quickstep");
+      EXPECT_EQ(j["speculative_contacts"], false);
+      // Settings of the reference solver do not apply to ODE: null, not the scene's numbers.
+      for (const char* key : {"tolerance", "relaxed_solver", "coulomb_iterations", "ipm_rounds"}) {
+        EXPECT_TRUE(j[key].is_null()) << key;
+      }
+    } else {
+      EXPECT_EQ(j["engine"], "reference");
+      EXPECT_EQ(j["mode"], "relaxed_ccp");  // coulomb_iterations 0
+      EXPECT_EQ(j["tolerance"], 0.0009765625);
+      EXPECT_EQ(j["relaxed_solver"], "pgs");  // apgd false
+      EXPECT_TRUE(j["speculative_contacts"].is_null());
+      EXPECT_TRUE(j["ipm_rounds"].is_null());
+    }
+  }
+}
+
+// ODE's direct stepper has no iteration count and never warm-starts; the reference's true
+// Coulomb mode by NSGS runs NSGS's own sweep budget, not solver.iterations.
+TEST(RunHealth, JsonLeavesOutWhatTheModeDoesNotUse) {
+  Scene s = parseScene(kSolverSceneFile, "solver_record.json");
+  s.solver.ode_quickstep = false;
+  const nlohmann::json ode =
+      nlohmann::json::parse(summaryJson(measureRun(s, Method::OdeRheonomic)))["solver"];
+  EXPECT_EQ(ode["mode"], "world_step");
+  EXPECT_TRUE(ode["iterations"].is_null());
+  EXPECT_EQ(ode["warm_start"], false);
+
+  s = parseScene(kSolverSceneFile, "solver_record.json");
+  s.solver.coulomb_iterations = 4;
+  const nlohmann::json ref =
+      nlohmann::json::parse(summaryJson(measureRun(s, Method::ReferenceRheonomic)))["solver"];
+  EXPECT_EQ(ref["mode"], "coulomb_nsgs");
+  EXPECT_EQ(ref["iterations"], reference::Settings().nsgs.max_iterations);
+  EXPECT_EQ(ref["tolerance"], 0.0009765625);
+  EXPECT_EQ(ref["ipm_rounds"], reference::Settings().ipm_rounds);
+  EXPECT_TRUE(ref["relaxed_solver"].is_null());
+  EXPECT_TRUE(ref["coulomb_iterations"].is_null());
 }
 
 // ---- Determinism ----------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 // A run's own files: the drift series CSV, the one-line JSON summary, and its plots.
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "output_json.hpp"
@@ -85,6 +86,36 @@ OrderedJson healthJson(const RunHealth& h) {
   return j;
 }
 
+// An optional setting: null where it does not apply (AppliedSolver).
+template <typename T>
+OrderedJson orNull(const std::optional<T>& value) {
+  return value ? OrderedJson(*value) : OrderedJson();
+}
+
+OrderedJson orNull(const std::string& text) {
+  return text.empty() ? OrderedJson() : OrderedJson(text);
+}
+
+OrderedJson solverJson(const AppliedSolver& a) {
+  OrderedJson j;
+  j["engine"] = orNull(a.engine);
+  j["mode"] = orNull(a.mode);
+  j["iterations"] = orNull(a.iterations);
+  j["tolerance"] = orNull(a.tolerance);
+  j["relaxed_solver"] = orNull(a.relaxed_solver);
+  j["coulomb_iterations"] = orNull(a.coulomb_iterations);
+  j["ipm_rounds"] = orNull(a.ipm_rounds);
+  j["warm_start"] = a.warm_start;
+  j["speculative_contacts"] = orNull(a.speculative_contacts);
+  j["erp"] = a.erp;
+  j["cfm"] = a.cfm;
+  j["max_correcting_velocity_mps"] = a.max_correcting_velocity;
+  j["surface_layer_m"] = a.surface_layer;
+  j["surface"] = {
+      {"mu", a.mu}, {"restitution", a.restitution}, {"bounce_velocity_mps", a.bounce_velocity}};
+  return j;
+}
+
 // RunHealth::local_law and the table's corners at the start.
 OrderedJson localLawJson(const RunHealth& h) {
   const LocalDriftStats& l = h.local_law;
@@ -123,6 +154,7 @@ std::string summaryJson(const RunMetrics& r) {
   j["drift_models"] = r.drift_models;
   j["friction"] = r.health.friction_model;
   j["broad_phase"] = r.health.broad_phase;
+  j["solver"] = solverJson(r.solver);
   j["health"] = healthJson(r.health);
   j["scene_check"] = r.scene_check;
   j["feeder"] = feederJsonValue(r.feeder);

@@ -40,6 +40,7 @@ class PartSimulation : public Simulation {
   ContactTotals contactTotals() const final { return totals_; }
   Method method() const final { return method_; }
   const RunHealth& health() const final { return health_; }
+  const AppliedSolver& appliedSolver() const final { return applied_; }
   bool partLost(int index) const final { return tracks_.at(static_cast<std::size_t>(index)).lost; }
   void setStageTiming(bool on) final { stage_timing_ = on; }
   const StageTimes& stageTimes() const final { return stage_times_; }
@@ -85,6 +86,8 @@ class PartSimulation : public Simulation {
 
   const Scene scene_;
   RunHealth health_;
+  /// Filled by the engine's constructor (appliedSolver).
+  AppliedSolver applied_;
   /// Stage timing (Simulation::setStageTiming): engines add their stages' seconds and contact
   /// counts to stage_times_ only while stageTiming() is true; StageClock reads no clock when
   /// given nullptr (`stageTiming() ? &stage_times_.solve : nullptr`).

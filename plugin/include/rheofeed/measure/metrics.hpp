@@ -161,6 +161,9 @@ struct RunMetrics {
   double real_time_factor = 0;
   /// What the run lost, could not trust or ignored (simulation.hpp).
   RunHealth health;
+  /// The dynamics settings the engine applied (Simulation::appliedSolver: iterations, warm
+  /// start, ERP, CFM, contact surface...; empty where they do not apply to the method).
+  AppliedSolver solver;
   /// The scene check's warnings before the run (reportSceneCheck, simulation/check.hpp: kind,
   /// values, safe setting), one formatted line each; filled by the caller of measureRun.
   std::vector<std::string> scene_check;
