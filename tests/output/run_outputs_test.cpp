@@ -273,6 +273,24 @@ TEST(SummaryJson, NonFiniteNumbersAreNull) {
   EXPECT_TRUE(j["health"]["max_part_speed_mps"].is_null());
 }
 
+TEST(SummaryJson, PartEventsNameTheirFamily) {
+  RunMetrics r = run();
+  PartEvent e;
+  e.part = 3;
+  e.family = "M6 nuts";
+  e.kind = "fell";
+  r.health.part_events = {e};
+  PartEvent inside = e;
+  inside.part = 4;
+  inside.family = "washers";
+  inside.kind = "inside_fixture";
+  r.health.inside_fixture_now = {inside};
+  const json events = json::parse(summaryJson(r))["health"]["part_events"];
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0]["family"], "M6 nuts");
+  EXPECT_EQ(events[1]["family"], "washers");
+}
+
 TEST(SummaryJson, AngularRunsSayRadiansPerSecond) {
   RunMetrics r = run();
   r.angular = true;

@@ -330,6 +330,26 @@ TEST(RunHealth, EveryCountedPartIsAnEventWithTheRunsCount) {
   EXPECT_EQ(h.part_events_dropped, 0);
 }
 
+// Which kind of part was lost: a cube resting on the floor (family "resting", spawned first)
+// and the thrown cube (family "thrown", part 1) that tunnels: its event names its family, in
+// the simulation's record and in the run JSON.
+TEST(RunHealth, PartEventsNameThePartsFamily) {
+  Scene s = thinFloorScene(kStartHeight, kThrowSpeed);
+  s.parts[0].name = "thrown";
+  PartSpec resting = cube(kEdge, {0.3, 0, 0.5 * kEdge + 0.002});
+  resting.name = "resting";
+  s.parts.insert(s.parts.begin(), resting);
+  s.duration = 2 * kStep;
+  const RunMetrics r = measureRun(s, Method::OdeRheonomic);
+  ASSERT_EQ(r.health.part_events.size(), 1u);
+  EXPECT_EQ(r.health.part_events[0].part, 1);
+  EXPECT_EQ(r.health.part_events[0].family, "thrown");
+  const nlohmann::json events = nlohmann::json::parse(summaryJson(r))["health"]["part_events"];
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0]["family"], "thrown");
+  EXPECT_EQ(events[0]["kind"], "through_fixture");
+}
+
 // ---- Falls, bounds, exits -----------------------------------------------------------------
 
 // A frictionless 20 cm square floor (top z = 0); a 2 cm cube on it 5 cm from its +x edge,

@@ -42,6 +42,7 @@ OrderedJson vec3Json(const Vec3& v) {
 
 OrderedJson partEventJson(const PartEvent& e) {
   return {{"part", e.part},
+          {"family", e.family},
           {"kind", e.kind},
           {"t_s", e.time},
           {"position_m", vec3Json(e.position)},

@@ -156,6 +156,8 @@ class PartSimulation : public Simulation {
   // and records the event (RunHealth::part_events) under `key`.
   void countLoss(std::size_t i, const char* key, const std::string& kind, const std::string& what,
                  int& counter, const PartState& state);
+  // The family name of part i (PartSpec::name of its spec).
+  const std::string& familyName(std::size_t i) const;
   // Appends an event to RunHealth::part_events (or counts it dropped beyond the cap).
   void recordEvent(std::size_t i, const char* key, const std::string& what, const PartState& state);
 

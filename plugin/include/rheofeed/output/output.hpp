@@ -56,11 +56,17 @@ std::vector<std::string> writeFeederOutputs(const FeederMetrics& feeder,
 /// lost_left_feeder.
 std::string seriesCsv(const RunMetrics& run);
 
-/// One-line JSON summary of a run: all scalar fields, a "health" object with every count of
-/// RunHealth, parts_lost, the share of Coulomb fallback steps, the maximum part speed and its
-/// bound, and the list of ignored settings; the scene check's warnings; a "feeder" object
-/// (feederJson); and a "local_law" object (RunHealth::local_law: feeders, contacts,
-/// wall_contacts, cells_computed, model_runs, model_cpu_s (s); corners_at_start from
+/// One-line JSON summary of a run: all scalar fields; "scene_source" (RunMetrics::scene_file, or
+/// "built-in" for a scene built in code) and "rheofeed_version" (kVersion, version.hpp); a
+/// "solver" object with the settings the engine applied (RunMetrics::solver, AppliedSolver:
+/// engine, mode, iterations, tolerance, relaxed_solver, coulomb_iterations, ipm_rounds,
+/// warm_start, speculative_contacts, erp, cfm, max_correcting_velocity_mps, surface_layer_m and
+/// "surface": {mu, restitution, bounce_velocity_mps}; null where one does not apply); a "health"
+/// object with every count of RunHealth, parts_lost, the share of Coulomb fallback steps, the
+/// maximum part speed and its bound, the list of ignored settings and the part events (part,
+/// family, kind, t_s, position_m, velocity_mps, fixture, what); the scene check's warnings; a
+/// "feeder" object (feederJson); and a "local_law" object (RunHealth::local_law: feeders,
+/// contacts, wall_contacts, cells_computed, model_runs, model_cpu_s (s); corners_at_start from
 /// RunHealth::local_law_corners_at_start). Numbers are written in their shortest form that reads
 /// back exactly; a number that is not finite, a mean drift with no part measured and a 95 %
 /// interval over fewer than two parts are null.
