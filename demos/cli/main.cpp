@@ -19,6 +19,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/shipped_scenes.hpp"
+#include "rheofeed/version.hpp"
 
 namespace {
 
@@ -120,7 +121,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "rheofeed: vibratory feeders, belts and turntables at large time steps (ODE + "
       "rheonomic contacts)"};
-  app.set_version_flag("--version", std::string("rheofeed ") + RHEOFEED_VERSION);
+  app.set_version_flag("--version", std::string("rheofeed ") + rheofeed::kVersion);
   app.require_subcommand(1);
   app.footer(
       "Exit codes: 0 success; 1 a failure while running (check: hazards found); 2 bad input "

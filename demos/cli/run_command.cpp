@@ -299,6 +299,7 @@ int runCommand(const RunArgs& args) {
           measureRun(s, m, lineProgress(std::string("rheofeed run: ") + toString(m), s.duration),
                      {recorder.get()});
       r.scene_check = hazards;
+      r.scene_file = std::filesystem::absolute(plan.file).lexically_normal().string();
       writeRunOutputs(r, out.string(), toString(m));
       if (recorder) recorder->write(out / (toString(m) + std::string(".glb")));
       blocks.emplace_back(toString(m), seriesCsv(r));

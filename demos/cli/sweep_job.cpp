@@ -28,6 +28,7 @@
 #include "cli/commands.hpp"
 #include "cli/sweep.hpp"
 #include "rheofeed/output/output.hpp"
+#include "rheofeed/version.hpp"
 
 extern char** environ;
 
@@ -300,7 +301,7 @@ void prepareSweep(const Spec& spec, const Folder& folder) {
                    {"name", spec.name},
                    {"spec_file", fs::absolute(spec.file).lexically_normal().string()},
                    {"base_scene", spec.scene_file.string()},
-                   {"prepared_by", std::string("rheofeed ") + RHEOFEED_VERSION},
+                   {"prepared_by", std::string("rheofeed ") + kVersion},
                    {"map", spec.map_x >= 0 ? Json::array({spec.parameters[spec.map_x].name,
                                                           spec.parameters[spec.map_y].name})
                                            : Json()},
@@ -583,7 +584,7 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
                  {"health", Json::object()},
                  {"cpu_seconds", 0.0},
                  {"wall_seconds", 0.0},
-                 {"rheofeed_version", RHEOFEED_VERSION},
+                 {"rheofeed_version", kVersion},
                  {"scene", fs::relative(scene_file, folder.root, ec).string()},
                  {"scene_hash", job->scene_hash},
                  {"command", command},

@@ -4,12 +4,16 @@
 #   cmake -DCMD=<program|arg|arg...> [-DCODE=<exit code, default 0>] [-DOUT_MATCH=<regex>]
 #         [-DERR_MATCH=<regex>] [-DERR_NOT_MATCH=<regex>] [-DLAST_LINE=<regex>]
 #         [-DFILES=<file|file...>] [-DMAKE_DIRS=<dir|dir...>] [-DCOPY_TO=<path>]
-#         [-DSCENE_FROM=<scene file> -DSCENE_TO=<path> [-DSCENE_DRIFT_TABLE=<name>]] -P cli_test.cmake
+#         [-DSCENE_FROM=<scene file> -DSCENE_TO=<path> [-DSCENE_DRIFT_TABLE=<name>]]
+#         [-DJSON_FILE=<file> -DJSON_EQUALS=<member=value|member=value...>] -P cli_test.cmake
 # "|" separates the arguments. LAST_LINE must match the last non-empty line of stdout; every
 # file of FILES must exist afterwards (and be removed before). COPY_TO: the program is first
 # copied there (a binary moved away from its share/ folder) and that copy is run. SCENE_FROM and
 # SCENE_TO: the scene file is first written to SCENE_TO with its top-level "drift_table" set to
-# SCENE_DRIFT_TABLE, or removed when that is empty or not given.
+# SCENE_DRIFT_TABLE, or removed when that is empty or not given. JSON_EQUALS: members of the
+# JSON file JSON_FILE (written by the command) and their values, a member named by its keys and
+# array indices joined by dots ("health.part_events.0.family"), a value as CMake's string(JSON)
+# reads it (a number as written, true and false as ON and OFF).
 string(REPLACE "|" ";" command "${CMD}")
 if(COPY_TO)
   list(GET command 0 program)
@@ -79,4 +83,23 @@ foreach(f IN LISTS files)
     message(FATAL_ERROR "${f} was not written\n${report}")
   endif()
 endforeach()
+if(DEFINED JSON_FILE)
+  file(READ "${JSON_FILE}" json_text)
+  string(REPLACE "|" ";" json_checks "${JSON_EQUALS}")
+  foreach(check IN LISTS json_checks)
+    string(FIND "${check}" "=" equals)
+    string(SUBSTRING "${check}" 0 ${equals} member)
+    math(EXPR after "${equals} + 1")
+    string(SUBSTRING "${check}" ${after} -1 expected)
+    string(REPLACE "." ";" keys "${member}")
+    string(JSON value ERROR_VARIABLE json_error GET "${json_text}" ${keys})
+    if(json_error)
+      message(FATAL_ERROR "${JSON_FILE}: ${member}: ${json_error}\n${report}")
+    endif()
+    if(NOT value STREQUAL expected)
+      message(FATAL_ERROR "${JSON_FILE}: ${member} is \"${value}\", expected \"${expected}\"\n"
+                          "${report}")
+    endif()
+  endforeach()
+endif()
 message(STATUS "${report}")

@@ -18,6 +18,8 @@
 #include "common/builtin_scenes.hpp"
 #include "rheofeed/measure/metrics.hpp"
 #include "rheofeed/output/output.hpp"
+#include "rheofeed/reference/world.hpp"
+#include "rheofeed/scene/scene_io.hpp"
 #include "rheofeed/simulation/simulation.hpp"
 #include "scene_builders.hpp"
 
@@ -328,6 +330,26 @@ TEST(RunHealth, EveryCountedPartIsAnEventWithTheRunsCount) {
   EXPECT_EQ(h.part_events_dropped, 0);
 }
 
+// Which kind of part was lost: a cube resting on the floor (family "resting", spawned first)
+// and the thrown cube (family "thrown", part 1) that tunnels: its event names its family, in
+// the simulation's record and in the run JSON.
+TEST(RunHealth, PartEventsNameThePartsFamily) {
+  Scene s = thinFloorScene(kStartHeight, kThrowSpeed);
+  s.parts[0].name = "thrown";
+  PartSpec resting = cube(kEdge, {0.3, 0, 0.5 * kEdge + 0.002});
+  resting.name = "resting";
+  s.parts.insert(s.parts.begin(), resting);
+  s.duration = 2 * kStep;
+  const RunMetrics r = measureRun(s, Method::OdeRheonomic);
+  ASSERT_EQ(r.health.part_events.size(), 1u);
+  EXPECT_EQ(r.health.part_events[0].part, 1);
+  EXPECT_EQ(r.health.part_events[0].family, "thrown");
+  const nlohmann::json events = nlohmann::json::parse(summaryJson(r))["health"]["part_events"];
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0]["family"], "thrown");
+  EXPECT_EQ(events[0]["kind"], "through_fixture");
+}
+
 // ---- Falls, bounds, exits -----------------------------------------------------------------
 
 // A frictionless 20 cm square floor (top z = 0); a 2 cm cube on it 5 cm from its +x edge,
@@ -549,6 +571,83 @@ TEST(RunHealth, ReferenceJsonCountsFallbackStepsAsTheWorldReportsThem) {
   EXPECT_LE(r.health.coulomb_fallback_steps, r.health.steps);
   EXPECT_NEAR(h.at("coulomb_fallback_share").get<double>(),
               double(r.health.coulomb_fallback_steps) / r.health.steps, 1e-6);
+}
+
+// The run JSON's "solver" is what the engine applied; here every setting differs from its
+// default, and the expected values are the scene file's own numbers (binary fractions: an ODE
+// built in single precision reads them back exactly).
+constexpr const char* kSolverSceneFile = R"({
+  "format_version": 1,
+  "name": "solver_record",
+  "duration": 0.05,
+  "fixtures": [{"name": "floor", "geoms": [{"shape": "box", "size": [0.5, 0.5, 0.05],
+                                            "position": [0, 0, -0.025]}]}],
+  "parts": [{"name": "cubes", "shape": "box", "count": 1, "density": 1000,
+             "size": [{"mean": 0.02}, {"mean": 0.02}, {"mean": 0.02}],
+             "spawn_min": [0, 0, 0.0105], "spawn_max": [0, 0, 0.0105]}],
+  "material": {"mu": 0.375, "restitution": 0.25},
+  "solver": {"time_step": 0.005, "iterations": 17, "ode_quickstep": true, "erp": 0.375,
+             "cfm": 0.0001220703125, "tolerance": 0.0009765625, "apgd": false,
+             "coulomb_iterations": 0, "max_correcting_velocity": 0.625,
+             "surface_layer": 0.0009765625, "warm_start": false, "speculative_contacts": false},
+  "outputs": {"sample_interval": 0.01}
+})";
+
+TEST(RunHealth, JsonRecordsTheSolverSettingsTheEngineApplied) {
+  const Scene s = parseScene(kSolverSceneFile, "solver_record.json");
+  for (Method m : kRheonomic) {
+    SCOPED_TRACE(toString(m));
+    const nlohmann::json j = nlohmann::json::parse(summaryJson(measureRun(s, m)))["solver"];
+    EXPECT_EQ(j["iterations"], 17);
+    // ODE takes the scene's false; the reference engine always warm-starts its own solves
+    EXPECT_EQ(j["warm_start"], m != Method::OdeRheonomic);
+    EXPECT_EQ(j["erp"], 0.375);
+    EXPECT_EQ(j["cfm"], 0.0001220703125);
+    EXPECT_EQ(j["max_correcting_velocity_mps"], 0.625);
+    EXPECT_EQ(j["surface_layer_m"], 0.0009765625);
+    EXPECT_EQ(j["surface"]["mu"], 0.375);
+    EXPECT_EQ(j["surface"]["restitution"], 0.25);
+    EXPECT_EQ(j["surface"]["bounce_velocity_mps"], 0);
+    if (m == Method::OdeRheonomic) {
+      EXPECT_EQ(j["engine"], "ode");
+      EXPECT_EQ(j["mode"], "quickstep");
+      EXPECT_EQ(j["speculative_contacts"], false);
+      // Settings of the reference solver do not apply to ODE: null, not the scene's numbers.
+      for (const char* key : {"tolerance", "relaxed_solver", "coulomb_iterations", "ipm_rounds"}) {
+        EXPECT_TRUE(j[key].is_null()) << key;
+      }
+    } else {
+      EXPECT_EQ(j["engine"], "reference");
+      EXPECT_EQ(j["mode"], "relaxed_ccp");  // coulomb_iterations 0
+      EXPECT_EQ(j["tolerance"], 0.0009765625);
+      EXPECT_EQ(j["relaxed_solver"], "pgs");  // apgd false
+      EXPECT_TRUE(j["speculative_contacts"].is_null());
+      EXPECT_TRUE(j["ipm_rounds"].is_null());
+    }
+  }
+}
+
+// ODE's direct stepper has no iteration count and never warm-starts; the reference's true
+// Coulomb mode by NSGS runs NSGS's own sweep budget, not solver.iterations.
+TEST(RunHealth, JsonLeavesOutWhatTheModeDoesNotUse) {
+  Scene s = parseScene(kSolverSceneFile, "solver_record.json");
+  s.solver.ode_quickstep = false;
+  const nlohmann::json ode =
+      nlohmann::json::parse(summaryJson(measureRun(s, Method::OdeRheonomic)))["solver"];
+  EXPECT_EQ(ode["mode"], "world_step");
+  EXPECT_TRUE(ode["iterations"].is_null());
+  EXPECT_EQ(ode["warm_start"], false);
+
+  s = parseScene(kSolverSceneFile, "solver_record.json");
+  s.solver.coulomb_iterations = 4;
+  const nlohmann::json ref =
+      nlohmann::json::parse(summaryJson(measureRun(s, Method::ReferenceRheonomic)))["solver"];
+  EXPECT_EQ(ref["mode"], "coulomb_nsgs");
+  EXPECT_EQ(ref["iterations"], reference::Settings().nsgs.max_iterations);
+  EXPECT_EQ(ref["tolerance"], 0.0009765625);
+  EXPECT_EQ(ref["ipm_rounds"], reference::Settings().ipm_rounds);
+  EXPECT_TRUE(ref["relaxed_solver"].is_null());
+  EXPECT_TRUE(ref["coulomb_iterations"].is_null());
 }
 
 // ---- Determinism ----------------------------------------------------------------------------

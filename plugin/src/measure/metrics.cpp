@@ -177,6 +177,7 @@ class RunMeter : public RunObserver {
     m_.warmup = out_.warmup;
     m_.parts = sim.numParts();
     m_.health = sim.health();
+    m_.solver = sim.appliedSolver();
     finishDrift(sim);
     finishFeeder();
   }

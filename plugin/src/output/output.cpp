@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "output_json.hpp"
 #include "rheofeed/number_format.hpp"
 #include "rheofeed/output/plot.hpp"
 
@@ -142,49 +143,54 @@ std::string orientationCsv(const FeederMetrics& feeder) {
   return s.str();
 }
 
-std::string feederJson(const FeederMetrics& f) {
-  std::ostringstream s;
-  s << "{\"exit_plane\": " << (f.exit_plane ? "true" : "false") << ", \"up\": ["
-    << jsonNumber(f.up.x) << ", " << jsonNumber(f.up.y) << ", " << jsonNumber(f.up.z)
-    << "], \"first_exit_time_s\": " << jsonNumber(f.first_exit_time)
-    << ", \"note\": " << (f.note.empty() ? "null" : jsonQuoted(f.note))
-    << ", \"mean_exit_rate_per_min\": " << jsonNumber(f.mean_rate_per_min)
-    << ", \"rate_window_s\": " << jsonNumber(f.rate_window)
-    << ", \"parts_exited\": " << f.exit_times.size()
-    << ", \"spawned_beyond_exit\": " << f.spawned_beyond_exit << ", \"exit_rate_per_min\": [";
-  for (std::size_t k = 0; k < f.rate.size(); ++k) {
-    const RateWindow& w = f.rate[k];
-    s << (k ? ", " : "") << "{\"t_s\": " << jsonNumber(0.5 * (w.start + w.end))
-      << ", \"t_start_s\": " << jsonNumber(w.start) << ", \"t_end_s\": " << jsonNumber(w.end)
-      << ", \"exits\": " << w.exits << ", \"rate_per_min\": " << jsonNumber(w.rate_per_min)
-      << ", \"cumulative_exits\": " << w.cumulative << "}";
-  }
-  s << "], \"exit_times_s\": [";
-  for (std::size_t k = 0; k < f.exit_times.size(); ++k) {
-    s << (k ? ", " : "") << jsonNumber(f.exit_times[k]);
+OrderedJson feederJsonValue(const FeederMetrics& f) {
+  OrderedJson rate = OrderedJson::array();
+  for (const RateWindow& w : f.rate) {
+    rate.push_back({{"t_s", 0.5 * (w.start + w.end)},
+                    {"t_start_s", w.start},
+                    {"t_end_s", w.end},
+                    {"exits", w.exits},
+                    {"rate_per_min", w.rate_per_min},
+                    {"cumulative_exits", w.cumulative}});
   }
   const std::vector<std::string> keys = familyKeys(f);
-  s << "], \"families\": {";
+  OrderedJson families = OrderedJson::object(), orientation = OrderedJson::object();
   for (std::size_t k = 0; k < f.families.size(); ++k) {
     const FamilyExits& fam = f.families[k];
-    s << (k ? ", " : "") << jsonQuoted(keys[k])
-      << ": {\"shape\": " << jsonQuoted(toString(fam.shape)) << ", \"spawned\": " << fam.spawned
-      << ", \"exited\": " << fam.exited
-      << ", \"removed_without_exit\": " << fam.removed_without_exit
-      << ", \"lost_before_exit\": " << fam.lost_before_exit
-      << ", \"orientation_meaningful\": " << (fam.orientation_meaningful ? "true" : "false") << "}";
-  }
-  s << "}, \"exit_orientation\": {";
-  for (std::size_t k = 0; k < f.families.size(); ++k) {
-    s << (k ? ", " : "") << jsonQuoted(keys[k]) << ": {";
+    families[keys[k]] = {{"shape", toString(fam.shape)},
+                         {"spawned", fam.spawned},
+                         {"exited", fam.exited},
+                         {"removed_without_exit", fam.removed_without_exit},
+                         {"lost_before_exit", fam.lost_before_exit},
+                         {"orientation_meaningful", fam.orientation_meaningful}};
+    OrderedJson bins = OrderedJson::object();
     for (int a = 0; a < kUpAxisCount; ++a) {
-      s << (a ? ", " : "") << "\"" << toString(static_cast<UpAxis>(a))
-        << "\": " << f.families[k].up_axis[static_cast<std::size_t>(a)];
+      bins[toString(static_cast<UpAxis>(a))] = fam.up_axis[static_cast<std::size_t>(a)];
     }
-    s << "}";
+    orientation[keys[k]] = std::move(bins);
   }
-  s << "}}";
-  return s.str();
+  OrderedJson j;
+  j["exit_plane"] = f.exit_plane;
+  j["up"] = {f.up.x, f.up.y, f.up.z};
+  j["first_exit_time_s"] = f.first_exit_time;  // NaN without an exit: null
+  j["note"] = f.note.empty() ? OrderedJson() : OrderedJson(f.note);
+  j["mean_exit_rate_per_min"] = f.mean_rate_per_min;
+  j["rate_window_s"] = f.rate_window;
+  j["parts_exited"] = f.exit_times.size();
+  j["spawned_beyond_exit"] = f.spawned_beyond_exit;
+  j["exit_rate_per_min"] = std::move(rate);
+  j["exit_times_s"] = f.exit_times;
+  j["families"] = std::move(families);
+  j["exit_orientation"] = std::move(orientation);
+  return j;
+}
+
+std::string oneLineJson(const OrderedJson& value) {
+  return value.dump(-1, ' ', false, OrderedJson::error_handler_t::replace);
+}
+
+std::string feederJson(const FeederMetrics& f) {
+  return oneLineJson(feederJsonValue(f));
 }
 
 std::vector<std::string> writeFeederOutputs(const FeederMetrics& feeder,

@@ -2,12 +2,14 @@
 // A run's own files: the drift series CSV, the one-line JSON summary, and its plots.
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
+#include "output_json.hpp"
 #include "rheofeed/measure/statistics.hpp"
-#include "rheofeed/number_format.hpp"
 #include "rheofeed/output/output.hpp"
 #include "rheofeed/output/plot.hpp"
+#include "rheofeed/version.hpp"
 
 namespace rheofeed::scene {
 
@@ -32,85 +34,133 @@ std::string seriesCsv(const RunMetrics& run) {
   return s.str();
 }
 
+namespace {
+
+OrderedJson vec3Json(const Vec3& v) {
+  return {v.x, v.y, v.z};
+}
+
+OrderedJson partEventJson(const PartEvent& e) {
+  return {{"part", e.part},
+          {"family", e.family},
+          {"kind", e.kind},
+          {"t_s", e.time},
+          {"position_m", vec3Json(e.position)},
+          {"velocity_mps", vec3Json(e.velocity)},
+          {"fixture", e.fixture},
+          {"what", e.what}};
+}
+
+OrderedJson healthJson(const RunHealth& h) {
+  OrderedJson j;
+  j["steps"] = h.steps;
+  j["parts_removed_after_exit"] = h.parts_exited;
+  j["parts_lost"] = h.partsLost();
+  j["parts_fell"] = h.parts_fell;
+  j["parts_through_fixture"] = h.parts_through_fixture;
+  j["parts_out_of_bounds"] = h.parts_out_of_bounds;
+  j["parts_nonfinite"] = h.parts_nonfinite;
+  j["parts_too_fast"] = h.parts_too_fast;
+  j["parts_inside_fixture"] = h.parts_inside_fixture;
+  j["parts_left_feeder"] = h.parts_left_feeder;
+  j["parts_sunk"] = h.parts_sunk;
+  j["coulomb_fallback_steps"] = h.coulomb_fallback_steps;
+  j["coulomb_fallback_share"] = h.steps > 0 ? double(h.coulomb_fallback_steps) / h.steps : 0.0;
+  j["solver_unconverged_steps"] = h.solver_unconverged_steps;
+  j["ipm_second_solve_steps"] = h.ipm_second_solve_steps;
+  j["ipm_converged_steps"] = h.ipm_converged_steps;
+  j["ipm_not_run_steps"] = h.ipm_not_run_steps;
+  j["friction_dropped_contacts"] = h.friction_dropped_contacts;
+  j["gyroscopic_fallback_steps"] = h.gyroscopic_fallback_steps;
+  j["max_part_speed_mps"] = h.max_part_speed;
+  j["speed_bound_mps"] = h.speed_bound;
+  j["max_physical_speed_ratio"] = h.max_speed_ratio;
+  j["speculative_contacts"] = h.speculative_contacts;
+  j["warm_started_contacts"] = h.warm_started_contacts;
+  j["passes_stopped"] = h.passes_stopped;
+  j["ignored_settings"] = h.ignored_settings;
+  j["part_events_dropped"] = h.part_events_dropped;
+  OrderedJson events = OrderedJson::array();  // the counted parts, then those inside now
+  for (const PartEvent& e : h.part_events) events.push_back(partEventJson(e));
+  for (const PartEvent& e : h.inside_fixture_now) events.push_back(partEventJson(e));
+  j["part_events"] = std::move(events);
+  return j;
+}
+
+// An optional setting: null where it does not apply (AppliedSolver).
+template <typename T>
+OrderedJson orNull(const std::optional<T>& value) {
+  return value ? OrderedJson(*value) : OrderedJson();
+}
+
+OrderedJson orNull(const std::string& text) {
+  return text.empty() ? OrderedJson() : OrderedJson(text);
+}
+
+OrderedJson solverJson(const AppliedSolver& a) {
+  OrderedJson j;
+  j["engine"] = orNull(a.engine);
+  j["mode"] = orNull(a.mode);
+  j["iterations"] = orNull(a.iterations);
+  j["tolerance"] = orNull(a.tolerance);
+  j["relaxed_solver"] = orNull(a.relaxed_solver);
+  j["coulomb_iterations"] = orNull(a.coulomb_iterations);
+  j["ipm_rounds"] = orNull(a.ipm_rounds);
+  j["warm_start"] = a.warm_start;
+  j["speculative_contacts"] = orNull(a.speculative_contacts);
+  j["erp"] = a.erp;
+  j["cfm"] = a.cfm;
+  j["max_correcting_velocity_mps"] = a.max_correcting_velocity;
+  j["surface_layer_m"] = a.surface_layer;
+  j["surface"] = {
+      {"mu", a.mu}, {"restitution", a.restitution}, {"bounce_velocity_mps", a.bounce_velocity}};
+  return j;
+}
+
+// RunHealth::local_law and the table's corners at the start.
+OrderedJson localLawJson(const RunHealth& h) {
+  const LocalDriftStats& l = h.local_law;
+  return {{"feeders", h.local_law_feeders},
+          {"contacts", l.contacts},
+          {"wall_contacts", l.wall_contacts},
+          {"cells_computed", l.cells_computed},
+          {"model_runs", l.model_runs},
+          {"model_cpu_s", l.model_cpu_seconds},
+          {"corners_at_start", h.local_law_corners_at_start}};
+}
+
+}  // namespace
+
 std::string summaryJson(const RunMetrics& r) {
-  char ci[32] = "null";  // no confidence interval over fewer than two parts
-  if (ci95Defined(r.drift_parts)) std::snprintf(ci, sizeof ci, "%.8g", r.mean_drift_ci95);
-  char drift[32] = "null";  // no part measured
-  if (r.drift_parts > 0) std::snprintf(drift, sizeof drift, "%.8g", r.mean_drift);
-  char b[768];
-  std::snprintf(b, sizeof b,
-                ", \"method\": \"%s\", \"time_step_s\": %.8g, \"parts\": %d, "
-                "\"drift_unit\": \"%s\", \"mean_drift\": %s, \"mean_drift_ci95\": %s, "
-                "\"vertical_displacement_m\": %.8g, \"throughput_parts_per_s\": %.8g, "
-                "\"cpu_seconds\": %.6g, \"simulated_seconds\": %.6g, \"real_time_factor\": %.6g",
-                toString(r.method), r.time_step, r.parts, r.angular ? "rad/s" : "m/s", drift, ci,
-                r.vertical_displacement, r.throughput, r.cpu_seconds, r.simulated_seconds,
-                r.real_time_factor);
-  std::string run = b;  // the run's own settings: seed and drift models
-  run += ", \"warmup_s\": " + formatNumber(r.warmup);  // the mean drift's window starts there
-  run += ", \"seed\": " + std::to_string(r.seed) + ", \"drift_models\": [";
-  for (std::size_t k = 0; k < r.drift_models.size(); ++k) {
-    run += (k ? ", " : "") + jsonQuoted(r.drift_models[k]);
-  }
-  run += "], \"friction\": " + jsonQuoted(r.health.friction_model) +
-         ", \"broad_phase\": " + jsonQuoted(r.health.broad_phase);
-  const RunHealth& h = r.health;
-  char c[1792];
-  std::snprintf(
-      c, sizeof c,
-      ", \"health\": {\"steps\": %ld, \"parts_removed_after_exit\": %d, \"parts_lost\": %d, "
-      "\"parts_fell\": %d, \"parts_through_fixture\": %d, \"parts_out_of_bounds\": %d, "
-      "\"parts_nonfinite\": %d, \"parts_too_fast\": %d, \"parts_inside_fixture\": %d, "
-      "\"parts_left_feeder\": %d, \"parts_sunk\": %d, "
-      "\"coulomb_fallback_steps\": %ld, "
-      "\"coulomb_fallback_share\": %.6g, \"solver_unconverged_steps\": %ld, "
-      "\"ipm_second_solve_steps\": %ld, \"ipm_converged_steps\": %ld, "
-      "\"ipm_not_run_steps\": %ld, "
-      "\"friction_dropped_contacts\": %ld, \"gyroscopic_fallback_steps\": %ld, "
-      "\"max_part_speed_mps\": %.6g, \"speed_bound_mps\": %.6g, "
-      "\"max_physical_speed_ratio\": %.6g, \"speculative_contacts\": %ld, "
-      "\"warm_started_contacts\": %ld, \"passes_stopped\": %ld, \"ignored_settings\": [",
-      h.steps, h.parts_exited, h.partsLost(), h.parts_fell, h.parts_through_fixture,
-      h.parts_out_of_bounds, h.parts_nonfinite, h.parts_too_fast, h.parts_inside_fixture,
-      h.parts_left_feeder, h.parts_sunk, h.coulomb_fallback_steps,
-      h.steps > 0 ? double(h.coulomb_fallback_steps) / h.steps : 0.0, h.solver_unconverged_steps,
-      h.ipm_second_solve_steps, h.ipm_converged_steps, h.ipm_not_run_steps,
-      h.friction_dropped_contacts, h.gyroscopic_fallback_steps, h.max_part_speed, h.speed_bound,
-      h.max_speed_ratio, h.speculative_contacts, h.warm_started_contacts, h.passes_stopped);
-  std::string json = "{\"scene\": " + jsonQuoted(r.scene) + run + c;
-  for (std::size_t k = 0; k < h.ignored_settings.size(); ++k) {
-    json += (k ? ", " : "") + jsonQuoted(h.ignored_settings[k]);
-  }
-  json += "], \"part_events_dropped\": " + std::to_string(h.part_events_dropped) +
-          ", \"part_events\": [";
-  std::vector<const PartEvent*> events;
-  for (const PartEvent& e : h.part_events) events.push_back(&e);
-  for (const PartEvent& e : h.inside_fixture_now) events.push_back(&e);
-  for (std::size_t k = 0; k < events.size(); ++k) {
-    const PartEvent& e = *events[k];
-    const auto vec = [](const Vec3& v) {
-      return "[" + jsonNumber(v.x) + ", " + jsonNumber(v.y) + ", " + jsonNumber(v.z) + "]";
-    };
-    json += std::string(k ? ", " : "") + "{\"part\": " + std::to_string(e.part) +
-            ", \"kind\": " + jsonQuoted(e.kind) + ", \"t_s\": " + jsonNumber(e.time) +
-            ", \"position_m\": " + vec(e.position) + ", \"velocity_mps\": " + vec(e.velocity) +
-            ", \"fixture\": " + jsonQuoted(e.fixture) + ", \"what\": " + jsonQuoted(e.what) + "}";
-  }
-  json += "]}, \"scene_check\": [";
-  for (std::size_t k = 0; k < r.scene_check.size(); ++k) {
-    json += (k ? ", " : "") + jsonQuoted(r.scene_check[k]);
-  }
-  const LocalDriftStats& l = h.local_law;  // RunHealth::local_law (simulation.hpp)
-  char d[384];
-  std::snprintf(d, sizeof d,
-                "{\"feeders\": %d, \"contacts\": %lld, \"wall_contacts\": %lld, "
-                "\"cells_computed\": %lld, \"model_runs\": %lld, \"model_cpu_s\": %.6g, "
-                "\"corners_at_start\": %lld}",
-                h.local_law_feeders, static_cast<long long>(l.contacts),
-                static_cast<long long>(l.wall_contacts), static_cast<long long>(l.cells_computed),
-                static_cast<long long>(l.model_runs), l.model_cpu_seconds,
-                static_cast<long long>(h.local_law_corners_at_start));
-  return json + "], \"feeder\": " + feederJson(r.feeder) + ", \"local_law\": " + d + "}";
+  OrderedJson j;
+  j["scene"] = r.scene;
+  j["scene_source"] = r.scene_file.empty() ? std::string("built-in") : r.scene_file;
+  j["rheofeed_version"] = kVersion;
+  j["method"] = toString(r.method);
+  j["time_step_s"] = r.time_step;
+  j["parts"] = r.parts;
+  j["drift_unit"] = r.angular ? "rad/s" : "m/s";
+  // null, not 0: no part measured, and no confidence interval over fewer than two parts
+  j["mean_drift"] = r.drift_parts > 0 ? OrderedJson(r.mean_drift) : OrderedJson();
+  j["mean_drift_ci95"] =
+      ci95Defined(r.drift_parts) ? OrderedJson(r.mean_drift_ci95) : OrderedJson();
+  j["vertical_displacement_m"] = r.vertical_displacement;
+  j["throughput_parts_per_s"] = r.throughput;
+  j["cpu_seconds"] = r.cpu_seconds;
+  j["simulated_seconds"] = r.simulated_seconds;
+  j["real_time_factor"] = r.real_time_factor;
+  // the run's own settings: the mean drift's window, seed and drift models
+  j["warmup_s"] = r.warmup;
+  j["seed"] = r.seed;
+  j["drift_models"] = r.drift_models;
+  j["friction"] = r.health.friction_model;
+  j["broad_phase"] = r.health.broad_phase;
+  j["solver"] = solverJson(r.solver);
+  j["health"] = healthJson(r.health);
+  j["scene_check"] = r.scene_check;
+  j["feeder"] = feederJsonValue(r.feeder);
+  j["local_law"] = localLawJson(r.health);
+  return oneLineJson(j);
 }
 
 std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::string& folder,

@@ -96,6 +96,7 @@ class OdeSimulation final : public PartSimulation {
       return true;
     });
     rows_per_contact_ = mu > 0 ? 3 : 1;
+    recordApplied(cs, mu, bounce);
     random_state_ = randomSeed(scene.seed);
     listIgnoredSettings();
     spawnDue();
@@ -190,6 +191,24 @@ class OdeSimulation final : public PartSimulation {
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
     return static_cast<unsigned long>((z ^ (z >> 31)) & 0xffffffffULL);
+  }
+
+  // What the world and the collider took (AppliedSolver): the world's settings read back from
+  // ODE (in its precision), the collider's as given, the surface as the callback sets it.
+  void recordApplied(const ContactCollider::Settings& cs, double mu, double bounce) {
+    AppliedSolver& a = applied_;
+    a.engine = "ode";
+    a.mode = scene_.solver.ode_quickstep ? "quickstep" : "world_step";
+    if (scene_.solver.ode_quickstep) a.iterations = dWorldGetQuickStepNumIterations(world_);
+    a.warm_start = cs.warm_start;
+    a.speculative_contacts = cs.speculative;
+    a.erp = dWorldGetERP(world_);
+    a.cfm = dWorldGetCFM(world_);
+    a.max_correcting_velocity = dWorldGetContactMaxCorrectingVel(world_);
+    a.surface_layer = dWorldGetContactSurfaceLayer(world_);
+    a.mu = mu;
+    a.restitution = bounce;
+    a.bounce_velocity = 0;
   }
 
   // Settings of the scene ODE does not read, when they differ from their defaults.

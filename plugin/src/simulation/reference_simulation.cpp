@@ -38,6 +38,7 @@ class ReferenceSimulation final : public PartSimulation {
     s.surface_layer = scene.solver.surface_layer;
     if (adjust) adjust(s);
     world_ = std::make_unique<reference::World>(s);
+    recordApplied(world_->settings());
     world_->setStepObserver(std::move(observer));
 
     for (std::size_t fi = 0; fi < scene.fixtures.size(); ++fi) {
@@ -65,6 +66,29 @@ class ReferenceSimulation final : public PartSimulation {
     }
     listIgnoredSettings();
     spawnDue();
+  }
+
+  // What the world took (AppliedSolver), after any adjustment: the mode its solve stage picks
+  // from the settings (world_contacts.cpp, solveStage) and what that mode reads.
+  void recordApplied(const reference::Settings& s) {
+    AppliedSolver& a = applied_;
+    a.engine = "reference";
+    const bool coulomb = s.solver.coulomb_outer_iterations > 0;
+    const bool nsgs = coulomb && s.coulomb_solver == reference::CoulombSolver::Nsgs;
+    a.mode = !coulomb ? "relaxed_ccp" : nsgs ? "coulomb_nsgs" : "coulomb_fixed_point";
+    a.iterations = nsgs ? s.nsgs.max_iterations : s.solver.max_iterations;
+    a.tolerance = s.solver.tolerance;
+    if (!nsgs) a.relaxed_solver = s.solver.method == ccp::Method::Apgd ? "apgd" : "pgs";
+    if (coulomb && !nsgs) a.coulomb_iterations = s.solver.coulomb_outer_iterations;
+    if (nsgs) a.ipm_rounds = s.ipm_rounds;
+    a.warm_start = s.warm_start;
+    a.erp = s.erp;
+    a.cfm = s.cfm;
+    a.max_correcting_velocity = s.max_correcting_velocity;
+    a.surface_layer = s.surface_layer;
+    a.mu = s.default_mu;
+    a.restitution = s.restitution;
+    a.bounce_velocity = s.bounce_velocity;
   }
 
   // Counts the steps whose contact solve cannot be trusted fully (RunHealth).

@@ -62,9 +62,9 @@ void HealthReport::onEnd(const Simulation& sim) {
   for (std::size_t k = 0; k < h.inside_fixture_now.size() && k < kInsideNamed; ++k) {
     const PartEvent& e = h.inside_fixture_now[k];
     std::fprintf(stderr,
-                 "rheofeed: %s, %s: part %d went into fixture %s at t = %g s and is inside it at "
-                 "the end, x = (%g, %g, %g) m\n",
-                 scene_name_.c_str(), toString(sim.method()), e.part,
+                 "rheofeed: %s, %s: part %d (%s) went into fixture %s at t = %g s and is inside "
+                 "it at the end, x = (%g, %g, %g) m\n",
+                 scene_name_.c_str(), toString(sim.method()), e.part, e.family.c_str(),
                  e.fixture.empty() ? "(unknown)" : e.fixture.c_str(), e.time, e.position.x,
                  e.position.y, e.position.z);
   }

@@ -577,10 +577,10 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const Vec3&
                             : "deeper than half the part)";
       recordEvent(i, "sunk", what, s);
       std::ostringstream line;
-      line << "part " << i
-           << (tr.off_centre ? "'s anchor (a point inside its material: its centre of mass lies "
+      line << "part " << i << " (" << familyName(i) << "): "
+           << (tr.off_centre ? "its anchor (a point inside its material: its centre of mass lies "
                                "outside it) "
-                             : "'s centre ")
+                             : "its centre ")
            << what << " at t = " << time_ << " s, "
            << (tr.off_centre ? "the anchor at x = " : "x = ") << formatPosition(to);
       reportFirst("part sunk into a fixture", line.str());
@@ -590,6 +590,10 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const Vec3&
   countLoss(i, "through_fixture", kind,
             "passed through a fixture over several steps (tunnelled; kept)",
             health_.parts_through_fixture, s);
+}
+
+const std::string& PartSimulation::familyName(std::size_t i) const {
+  return scene_.parts.at(static_cast<std::size_t>(instances_.at(i).spec)).name;
 }
 
 void PartSimulation::recordEvent(std::size_t i, const char* key, const std::string& what,
@@ -603,6 +607,7 @@ void PartSimulation::recordEvent(std::size_t i, const char* key, const std::stri
       std::string_view(key) == "through_fixture" || std::string_view(key) == "sunk";
   PartEvent e;
   e.part = static_cast<int>(i);
+  e.family = familyName(i);
   e.time = time_;
   e.kind = key;
   e.what = what;
@@ -624,7 +629,7 @@ void PartSimulation::countLoss(std::size_t i, const char* key, const std::string
   ++counter;
   recordEvent(i, key, what, state);
   std::ostringstream line;
-  line << "part " << i << " " << what << " at t = " << time_
+  line << "part " << i << " (" << familyName(i) << ") " << what << " at t = " << time_
        << " s, x = " << formatPosition(state.position) << ", v = " << formatPosition(state.velocity)
        << "/s, |w| = " << norm(state.angular_velocity) << " rad/s";
   reportFirst(kind, line.str());
@@ -738,6 +743,7 @@ void PartSimulation::step() {
     ++health_.parts_inside_fixture;
     PartEvent e;
     e.part = static_cast<int>(i);
+    e.family = familyName(i);
     e.time = tr.entry_time;
     e.kind = "inside_fixture";
     e.what = "went into a fixture and is inside it now";

@@ -40,6 +40,7 @@ class PartSimulation : public Simulation {
   ContactTotals contactTotals() const final { return totals_; }
   Method method() const final { return method_; }
   const RunHealth& health() const final { return health_; }
+  const AppliedSolver& appliedSolver() const final { return applied_; }
   bool partLost(int index) const final { return tracks_.at(static_cast<std::size_t>(index)).lost; }
   void setStageTiming(bool on) final { stage_timing_ = on; }
   const StageTimes& stageTimes() const final { return stage_times_; }
@@ -85,6 +86,8 @@ class PartSimulation : public Simulation {
 
   const Scene scene_;
   RunHealth health_;
+  /// Filled by the engine's constructor (appliedSolver).
+  AppliedSolver applied_;
   /// Stage timing (Simulation::setStageTiming): engines add their stages' seconds and contact
   /// counts to stage_times_ only while stageTiming() is true; StageClock reads no clock when
   /// given nullptr (`stageTiming() ? &stage_times_.solve : nullptr`).
@@ -153,6 +156,8 @@ class PartSimulation : public Simulation {
   // and records the event (RunHealth::part_events) under `key`.
   void countLoss(std::size_t i, const char* key, const std::string& kind, const std::string& what,
                  int& counter, const PartState& state);
+  // The family name of part i (PartSpec::name of its spec).
+  const std::string& familyName(std::size_t i) const;
   // Appends an event to RunHealth::part_events (or counts it dropped beyond the cap).
   void recordEvent(std::size_t i, const char* key, const std::string& what, const PartState& state);
 

@@ -124,7 +124,11 @@ struct FeederMetrics {
 
 /// The result of one run.
 struct RunMetrics {
-  std::string scene;
+  std::string scene;  ///< Scene::name
+  /// The scene file the run's scene was read from (the path as the caller resolved it: a file
+  /// given to `rheofeed run`, or a shipped scene's file); empty for a scene built in code (the
+  /// run JSON then says "built-in"). Filled by the caller of measureRun, which alone knows it.
+  std::string scene_file;
   Method method = Method::OdeRheonomic;
   double time_step = 0;    ///< (s)
   std::uint64_t seed = 0;  ///< Scene::seed of the run (to reproduce it)
@@ -157,6 +161,9 @@ struct RunMetrics {
   double real_time_factor = 0;
   /// What the run lost, could not trust or ignored (simulation.hpp).
   RunHealth health;
+  /// The dynamics settings the engine applied (Simulation::appliedSolver: iterations, warm
+  /// start, ERP, CFM, contact surface...; empty where they do not apply to the method).
+  AppliedSolver solver;
   /// The scene check's warnings before the run (reportSceneCheck, simulation/check.hpp: kind,
   /// values, safe setting), one formatted line each; filled by the caller of measureRun.
   std::vector<std::string> scene_check;

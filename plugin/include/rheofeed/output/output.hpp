@@ -30,7 +30,8 @@ std::string exitsCsv(const FeederMetrics& feeder);
 /// CSV of the exit orientations, one row per part family:
 /// family,shape,spawned,exited,removed_without_exit,orientation_meaningful,+x,-x,+y,-y,+z,-z.
 std::string orientationCsv(const FeederMetrics& feeder);
-/// The JSON object of the feeder metrics (no surrounding key):
+/// The JSON object of the feeder metrics (no surrounding key; numbers in their shortest form
+/// that reads back exactly, null where not finite):
 /// {"exit_plane", "up", "first_exit_time_s" (null when none), "note" (null when empty),
 /// "mean_exit_rate_per_min" (null with fewer than two exits), "rate_window_s", "parts_exited",
 /// "spawned_beyond_exit", "exit_rate_per_min": [{"t_s" (window centre), "t_start_s", "t_end_s",
@@ -55,12 +56,20 @@ std::vector<std::string> writeFeederOutputs(const FeederMetrics& feeder,
 /// lost_left_feeder.
 std::string seriesCsv(const RunMetrics& run);
 
-/// One-line JSON summary of a run: all scalar fields, a "health" object with every count of
-/// RunHealth, parts_lost, the share of Coulomb fallback steps, the maximum part speed and its
-/// bound, and the list of ignored settings; the scene check's warnings; a "feeder" object
-/// (feederJson); and a "local_law" object (RunHealth::local_law: feeders, contacts,
-/// wall_contacts, cells_computed, model_runs, model_cpu_s (s); corners_at_start from
-/// RunHealth::local_law_corners_at_start).
+/// One-line JSON summary of a run: all scalar fields; "scene_source" (RunMetrics::scene_file, or
+/// "built-in" for a scene built in code) and "rheofeed_version" (kVersion, version.hpp); a
+/// "solver" object with the settings the engine applied (RunMetrics::solver, AppliedSolver:
+/// engine, mode, iterations, tolerance, relaxed_solver, coulomb_iterations, ipm_rounds,
+/// warm_start, speculative_contacts, erp, cfm, max_correcting_velocity_mps, surface_layer_m and
+/// "surface": {mu, restitution, bounce_velocity_mps}; null where one does not apply); a "health"
+/// object with every count of RunHealth, parts_lost, the share of Coulomb fallback steps, the
+/// maximum part speed and its bound, the list of ignored settings and the part events (part,
+/// family, kind, t_s, position_m, velocity_mps, fixture, what); the scene check's warnings; a
+/// "feeder" object (feederJson); and a "local_law" object (RunHealth::local_law: feeders,
+/// contacts, wall_contacts, cells_computed, model_runs, model_cpu_s (s); corners_at_start from
+/// RunHealth::local_law_corners_at_start). Numbers are written in their shortest form that reads
+/// back exactly; a number that is not finite, a mean drift with no part measured and a 95 %
+/// interval over fewer than two parts are null.
 std::string summaryJson(const RunMetrics& run);
 
 /// Writes <stem>.csv, <stem>.json and, when gnuplot is available, <stem>.png (mean drift vs time

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,7 @@ struct ContactTotals {
 /// One part counted by RunHealth as lost or sunk: which, when, where and how.
 struct PartEvent {
   int part = -1;        ///< the part's index (spawn order)
+  std::string family;   ///< the part's family: PartSpec::name of its entry in Scene::parts
   double time = 0;      ///< simulated time of the step that found it (s); for "inside_fixture":
                         ///< the step it went into the fixture it is in (position and velocity
                         ///< are its state now)
@@ -353,6 +355,53 @@ struct StageTimes {
   long constraint_rows = 0;
 };
 
+/// The dynamics settings a simulation applied, as its engine took them (ODE: read back from its
+/// world with dWorldGet*; the reference engine: its World's settings), for the record of a run
+/// (RunMetrics::solver, the run JSON's "solver"). A setting that does not apply to the engine or
+/// to its mode is empty (null in the JSON). The time step is Scene::solver.time_step; the
+/// friction law and the broad phase are RunHealth::friction_model and broad_phase.
+struct AppliedSolver {
+  std::string engine;  ///< "ode" or "reference"; empty until a simulation fills it
+  /// How each step's contacts are solved. ODE: "quickstep" (dWorldQuickStep, iterative) or
+  /// "world_step" (dWorldStep, ODE's direct solver; SolverSettings::ode_quickstep = false). The
+  /// reference engine: "relaxed_ccp" (the convex relaxation: solver.coulomb_iterations = 0),
+  /// "coulomb_nsgs" (the true Coulomb law by NSGS, reference::CoulombSolver::Nsgs) or
+  /// "coulomb_fixed_point" (relaxed solves inside De Saxce's fixed point).
+  std::string mode;
+  /// Iteration budget of one step's contact solve. ODE quickstep: its iterations
+  /// (dWorldGetQuickStepNumIterations). Reference: the sweeps of NSGS in coulomb_nsgs
+  /// (reference::Settings::nsgs, not solver.iterations), else the APGD or PGS iterations of each
+  /// relaxed solve (solver.iterations). Empty for dWorldStep (a direct solver).
+  std::optional<int> iterations;
+  /// Reference: the relative residual (dimensionless) at which a contact solve stops
+  /// (solver.tolerance). Empty for ODE: quickstep runs all its iterations.
+  std::optional<double> tolerance;
+  /// Reference relaxed_ccp and coulomb_fixed_point: the relaxed solver, "apgd" or "pgs"
+  /// (solver.apgd). Empty otherwise.
+  std::string relaxed_solver;
+  /// Reference coulomb_fixed_point: its outer iterations (solver.coulomb_iterations). Empty
+  /// otherwise (NSGS solves the Coulomb law itself and only needs the count to be above 0).
+  std::optional<int> coulomb_iterations;
+  /// Reference coulomb_nsgs: rounds of the interior-point fixed point and NSGS after an
+  /// unconverged NSGS solve (reference::Settings::ipm_rounds). Empty otherwise.
+  std::optional<int> ipm_rounds;
+  /// Whether each step's contact solve starts from the last step's forces: ODE's contacts
+  /// (ContactCollider::Settings::warm_start, odeWarmStartsContacts: never with dWorldStep), the
+  /// reference's solves (reference::Settings::warm_start).
+  bool warm_start = false;
+  /// ODE: contacts across gaps (ContactCollider::Settings::speculative). Empty for the reference
+  /// engine, which makes contacts only where geoms overlap.
+  std::optional<bool> speculative_contacts;
+  double erp = 0;                      ///< error reduction parameter (dimensionless, [0, 1])
+  double cfm = 0;                      ///< constraint force mixing (ODE's units, >= 0)
+  double max_correcting_velocity = 0;  ///< cap on the push-out speed of a penetration (m/s)
+  double surface_layer = 0;            ///< penetration left uncorrected (m)
+  /// Every contact's surface (one material for all pairs: Scene::material): the friction
+  /// coefficient (dimensionless), the restitution (dimensionless) and the approach speed above
+  /// which a contact bounces (m/s; 0 in both engines).
+  double mu = 0, restitution = 0, bounce_velocity = 0;
+};
+
 class Simulation {
  public:
   virtual ~Simulation() = default;
@@ -376,6 +425,8 @@ class Simulation {
   virtual Method method() const = 0;
   /// What the run lost, could not trust or ignored so far.
   virtual const RunHealth& health() const = 0;
+  /// The dynamics settings the engine applied (set when the simulation is built).
+  virtual const AppliedSolver& appliedSolver() const = 0;
   /// Whether part `index` (0 <= index < numParts()) has been counted lost (RunHealth: through a
   /// fixture, left the feeder, fell, out of bounds, non-finite, too fast), whether or not it is
   /// still in the simulation. Not for a part that only sank and came back, nor for one inside a
