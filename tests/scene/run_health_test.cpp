@@ -20,6 +20,7 @@
 #include "rheofeed/output/output.hpp"
 #include "rheofeed/reference/world.hpp"
 #include "rheofeed/scene/scene_io.hpp"
+#include "rheofeed/simulation/reference_simulation.hpp"
 #include "rheofeed/simulation/simulation.hpp"
 #include "scene_builders.hpp"
 
@@ -488,9 +489,11 @@ bool mentions(const std::vector<std::string>& lines, const std::string& key) {
 }
 
 TEST(RunHealth, DefaultSettingsAreNeverListedAsIgnored) {
+  Scene s = beltScene();
+  s.solver.iterations = SolverSettings{}.iterations;  // beltScene's 100: see the NSGS test below
   for (Method m : kRheonomic) {
     SCOPED_TRACE(toString(m));
-    EXPECT_TRUE(makeSimulation(beltScene(), m)->health().ignored_settings.empty());
+    EXPECT_TRUE(makeSimulation(s, m)->health().ignored_settings.empty());
   }
 }
 
@@ -505,7 +508,27 @@ TEST(RunHealth, OdeListsTheReferenceSolverSettingsItIgnores) {
   EXPECT_TRUE(mentions(ignored, "solver.coulomb_iterations = 3"));
   EXPECT_TRUE(mentions(ignored, "solver.tolerance"));
   EXPECT_TRUE(mentions(ignored, "solver.apgd = false"));
-  // The reference reads all three.
+}
+
+// The reference's default true-Coulomb mode (NSGS) runs its own sweeps: the relaxed solver's
+// budget (solver.iterations) and choice (solver.apgd) are not read, and coulomb_iterations only
+// switches the mode on; its tolerance is read. In the relaxed mode (coulomb_iterations = 0) the
+// relaxed solver reads them all.
+TEST(RunHealth, ReferenceNsgsListsTheRelaxedSolversSettings) {
+  Scene s = beltScene();  // solver.iterations = 100
+  s.solver.coulomb_iterations = 3;
+  s.solver.tolerance = 1e-4;
+  s.solver.apgd = false;
+  const std::vector<std::string> ignored =
+      makeSimulation(s, Method::ReferenceRheonomic)->health().ignored_settings;
+  EXPECT_EQ(ignored.size(), 3u);
+  EXPECT_TRUE(mentions(ignored,
+                       "solver.iterations = 100: ignored by the reference solver's "
+                       "true-Coulomb NSGS (it runs up to 1000 sweeps"));
+  EXPECT_TRUE(mentions(ignored, "solver.apgd = false"));
+  EXPECT_TRUE(mentions(ignored, "solver.coulomb_iterations = 3: only switches"));
+  EXPECT_FALSE(mentions(ignored, "solver.tolerance = "));  // read (the sweeps run to it)
+  s.solver.coulomb_iterations = 0;
   EXPECT_TRUE(makeSimulation(s, Method::ReferenceRheonomic)->health().ignored_settings.empty());
 }
 
@@ -519,6 +542,7 @@ TEST(RunHealth, OdeDirectStepperIgnoresTheIterationCount) {
 
 TEST(RunHealth, ReferenceListsTheOdeStepperChoice) {
   Scene s = beltScene();
+  s.solver.iterations = SolverSettings{}.iterations;
   s.solver.ode_quickstep = false;
   const std::vector<std::string> ignored =
       makeSimulation(s, Method::ReferenceRheonomic)->health().ignored_settings;
@@ -561,10 +585,18 @@ TEST(RunHealth, JsonAndCsvCarryTheCounts) {
 }
 
 TEST(RunHealth, ReferenceJsonCountsFallbackStepsAsTheWorldReportsThem) {
-  // A pile on a belt: the true-Coulomb fixed point does not always settle in 10 iterations.
+  // A pile on a belt, solved by the relaxed CCP inside the true-Coulomb fixed point (the mode
+  // with a fallback; the default NSGS mode has none) allowed 2 outer iterations: some steps do
+  // not settle in them and take the fallback.
   Scene s = pileOnBeltScene(10);
   s.duration = 0.3;
-  const RunMetrics r = measureRun(s, Method::ReferenceRheonomic);
+  const auto sim = makeObservedReferenceSimulation(
+      s, Method::ReferenceRheonomic, {}, [](reference::Settings& settings) {
+        settings.coulomb_solver = reference::CoulombSolver::RelaxedFixedPoint;
+        settings.solver.coulomb_outer_iterations = 2;
+      });
+  const RunMetrics r = measureRun(*sim, s);
+  ASSERT_GT(r.health.coulomb_fallback_steps, 0) << "no step took the fallback: nothing is checked";
   const nlohmann::json h = nlohmann::json::parse(summaryJson(r)).at("health");
   EXPECT_EQ(h.at("coulomb_fallback_steps").get<long>(), r.health.coulomb_fallback_steps);
   EXPECT_EQ(h.at("solver_unconverged_steps").get<long>(), r.health.solver_unconverged_steps);

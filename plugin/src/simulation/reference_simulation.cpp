@@ -149,9 +149,9 @@ class ReferenceSimulation final : public PartSimulation {
       std::ostringstream line;
       line << "step from t = " << time() << " s: contact solve "
            << ccp::toString(report.solve.status) << " after " << report.solve.iterations
-           << " iterations (" << report.contacts
-           << " contacts, solver.iterations = " << scene_.solver.iterations
-           << ", solver.tolerance = " << scene_.solver.tolerance << ")";
+           << " iterations (" << report.contacts << " contacts; " << applied_.mode
+           << " runs at most " << applied_.iterations.value_or(0)
+           << " iterations to solver.tolerance = " << scene_.solver.tolerance << ")";
       reportFirst("unconverged step", line.str());
     }
   }
@@ -235,6 +235,26 @@ class ReferenceSimulation final : public PartSimulation {
     if (!scene_.solver.ode_quickstep) {
       ignoreSetting(
           "solver.ode_quickstep = false: ignored by the reference solver (ODE's stepper choice)");
+    }
+    // The true-Coulomb NSGS mode (the default) runs its own sweeps: the relaxed solver's budget
+    // and choice are not read, and coulomb_iterations only switches the mode on.
+    if (applied_.mode == "coulomb_nsgs") {
+      const SolverSettings defaults;
+      const SolverSettings& s = scene_.solver;
+      const std::string nsgs =
+          "ignored by the reference solver's true-Coulomb NSGS (it runs up "
+          "to " +
+          std::to_string(applied_.iterations.value_or(0)) + " sweeps to solver.tolerance)";
+      if (s.iterations != defaults.iterations) {
+        ignoreSetting("solver.iterations = " + std::to_string(s.iterations) + ": " + nsgs);
+      }
+      if (s.apgd != defaults.apgd) {
+        ignoreSetting(std::string("solver.apgd = ") + (s.apgd ? "true" : "false") + ": " + nsgs);
+      }
+      if (s.coulomb_iterations != defaults.coulomb_iterations) {
+        ignoreSetting("solver.coulomb_iterations = " + std::to_string(s.coulomb_iterations) +
+                      ": only switches the true-Coulomb mode on (any value > 0); " + nsgs);
+      }
     }
   }
 
