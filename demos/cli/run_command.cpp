@@ -247,6 +247,7 @@ int runCommand(const RunArgs& args) {
     for (const PlannedRun& r : plan.runs)
       any_rheonomic = any_rheonomic || !isFullVibration(r.method);
     Scene calibrated = plan.scene;
+    std::vector<std::string> calibration_warnings;  // CalibrateReport::imprecise, into each run
     const bool calibrating = any_rheonomic && needsCalibration(calibrated);
     noteIgnoredCycleOptions("rheofeed run", args.cycles_given, calibrating,
                             args.calibrate.classical);
@@ -256,6 +257,7 @@ int runCommand(const RunArgs& args) {
         if (!isFullVibration(r.method)) options.rheonomic_time_step = r.scene.solver.time_step;
       }
       const CalibrateReport c = calibrateScene(calibrated, options, "rheofeed run", stderr);
+      calibration_warnings = c.imprecise;
       std::fprintf(stderr,
                    "rheofeed run: calibration took %.1f s CPU; `rheofeed calibrate %s --out "
                    "NEW.json` saves it so that runs of NEW.json start at once\n",
@@ -299,6 +301,7 @@ int runCommand(const RunArgs& args) {
           measureRun(s, m, lineProgress(std::string("rheofeed run: ") + toString(m), s.duration),
                      {recorder.get()});
       r.scene_check = hazards;
+      if (!isFullVibration(m)) r.calibration_warnings = calibration_warnings;
       r.scene_file = std::filesystem::absolute(plan.file).lexically_normal().string();
       writeRunOutputs(r, out.string(), toString(m));
       if (recorder) recorder->write(out / (toString(m) + std::string(".glb")));

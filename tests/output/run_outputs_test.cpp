@@ -33,6 +33,12 @@ RunMetrics run() {
   r.time_step = 0.01;
   r.seed = std::numeric_limits<std::uint64_t>::max();  // every bit of the seed survives
   r.drift_models = {"track: local", "bowl: calibrated_drift"};
+  DriftField bowl;
+  bowl.fixture = "bowl";
+  bowl.drift_model = "calibrated_drift";
+  bowl.calibrated_drift = Twist{{0, 0, 0}, {0, 0, 0.3125}, {0.5, -0.25, 0}};
+  r.drift_fields = {DriftField{"track", "local", {}, std::nullopt}, bowl};
+  r.calibration_warnings = {"fixture 'bowl': the calibrated drift 0.3125 +- 0.0625 is known"};
   r.angular = false;
   DriftSample a;
   a.time = 0.5;
@@ -178,6 +184,14 @@ TEST(SummaryJson, ParsesToTheRunMetricsWritten) {
   EXPECT_DOUBLE_EQ(j["warmup_s"].get<double>(), r.warmup);
   EXPECT_EQ(j["seed"].get<std::uint64_t>(), r.seed);
   EXPECT_EQ(j["drift_models"], json(r.drift_models));
+  ASSERT_EQ(j["drift_fields"].size(), 2u);
+  EXPECT_EQ(j["drift_fields"][0]["fixture"], "track");
+  EXPECT_TRUE(j["drift_fields"][0]["efficiency"].is_null());
+  EXPECT_TRUE(j["drift_fields"][0]["calibrated_drift"].is_null());
+  EXPECT_EQ(j["drift_fields"][1]["drift_model"], "calibrated_drift");
+  EXPECT_EQ(j["drift_fields"][1]["calibrated_drift"]["angular_radps"], json({0, 0, 0.3125}));
+  EXPECT_EQ(j["drift_fields"][1]["calibrated_drift"]["origin_m"], json({0.5, -0.25, 0}));
+  EXPECT_EQ(j["calibration_warnings"], json(r.calibration_warnings));
 
   const json& h = j["health"];
   EXPECT_EQ(h["steps"], 1000);

@@ -186,6 +186,13 @@ TEST(RheonomicLaw, PartEfficiencyScalesTheDriftInBothEngines) {
     ASSERT_EQ(run.at("drift_models").size(), 1u);
     EXPECT_EQ(run.at("drift_models")[0].get<std::string>(),
               sampled.fixtures[0].name + ": local_sampled");
+    // ...and the efficiency it ran with (the scene's 0.5), per family.
+    const nlohmann::json& field = run.at("drift_fields").at(0);
+    EXPECT_EQ(field.at("drift_model"), "local_sampled");
+    ASSERT_EQ(field.at("efficiency").size(), 1u);
+    EXPECT_EQ(field.at("efficiency")[0].at("family"), sampled.parts[0].name);
+    EXPECT_EQ(field.at("efficiency")[0].at("efficiency").get<double>(), 0.5);
+    EXPECT_TRUE(field.at("calibrated_drift").is_null());
   }
 }
 

@@ -153,6 +153,18 @@ class RunMeter : public RunObserver {
     for (const Fixture& f : scene.fixtures) {
       if (f.law.kind == FeederLaw::Kind::Vibration) {
         m_.drift_models.push_back(f.name + ": " + toString(f.law.drift_model));
+        DriftField field;
+        field.fixture = f.name;
+        field.drift_model = toString(f.law.drift_model);
+        if (f.law.drift_model == DriftModel::LocalSampled) {
+          for (std::size_t k = 0; k < f.law.efficiency.size() && k < scene.parts.size(); ++k) {
+            field.efficiency.emplace_back(scene.parts[k].name, f.law.efficiency[k]);
+          }
+        }
+        if (f.law.drift_model == DriftModel::CalibratedDrift && f.law.has_calibrated_drift) {
+          field.calibrated_drift = f.law.calibrated_drift;
+        }
+        m_.drift_fields.push_back(std::move(field));
       }
     }
     m_.angular = out_.angular_drift;

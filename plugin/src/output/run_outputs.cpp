@@ -40,6 +40,28 @@ OrderedJson vec3Json(const Vec3& v) {
   return {v.x, v.y, v.z};
 }
 
+// A vibrating fixture's drift field as the run used it (DriftField): null where its model
+// has no such value.
+OrderedJson driftFieldJson(const DriftField& f) {
+  OrderedJson j;
+  j["fixture"] = f.fixture;
+  j["drift_model"] = f.drift_model;
+  j["efficiency"] = nullptr;
+  if (!f.efficiency.empty()) {
+    j["efficiency"] = OrderedJson::array();
+    for (const auto& [family, value] : f.efficiency) {
+      j["efficiency"].push_back({{"family", family}, {"efficiency", value}});
+    }
+  }
+  j["calibrated_drift"] = nullptr;
+  if (f.calibrated_drift) {
+    j["calibrated_drift"] = {{"linear_mps", vec3Json(f.calibrated_drift->linear)},
+                             {"angular_radps", vec3Json(f.calibrated_drift->angular)},
+                             {"origin_m", vec3Json(f.calibrated_drift->origin)}};
+  }
+  return j;
+}
+
 OrderedJson partEventJson(const PartEvent& e) {
   return {{"part", e.part},
           {"family", e.family},
@@ -153,6 +175,9 @@ std::string summaryJson(const RunMetrics& r) {
   j["warmup_s"] = r.warmup;
   j["seed"] = r.seed;
   j["drift_models"] = r.drift_models;
+  j["drift_fields"] = OrderedJson::array();
+  for (const DriftField& f : r.drift_fields) j["drift_fields"].push_back(driftFieldJson(f));
+  j["calibration_warnings"] = r.calibration_warnings;
   j["friction"] = r.health.friction_model;
   j["broad_phase"] = r.health.broad_phase;
   j["solver"] = solverJson(r.solver);

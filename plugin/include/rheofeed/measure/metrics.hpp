@@ -20,7 +20,9 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rheofeed/simulation/run.hpp"
@@ -122,6 +124,19 @@ struct FeederMetrics {
   std::string note;
 };
 
+/// What a rheonomic run drove a vibrating fixture with instead of its vibration (the scene's
+/// drift fields as the run used them, calibrated before it or given by the scene).
+struct DriftField {
+  std::string fixture;      ///< Fixture::name
+  std::string drift_model;  ///< "local", "local_sampled" or "calibrated_drift"
+  /// local_sampled: each part family's efficiency (dimensionless), as "family name", value;
+  /// empty for the other models.
+  std::vector<std::pair<std::string, double>> efficiency;
+  /// calibrated_drift: the constant drift twist (Twist: m/s, rad/s about the origin, m; world
+  /// frame); unset for the other models.
+  std::optional<Twist> calibrated_drift;
+};
+
 /// The result of one run.
 struct RunMetrics {
   std::string scene;  ///< Scene::name
@@ -135,6 +150,12 @@ struct RunMetrics {
   /// "fixture name: drift model" of every vibrating fixture (what a rheonomic run used instead
   /// of the vibration; full-vibration runs ignore it).
   std::vector<std::string> drift_models;
+  /// The same fixtures with the values their drift model used (efficiencies, calibrated drift).
+  std::vector<DriftField> drift_fields;
+  /// The calibrations of the scene's drift fields that were reported imprecise before the run
+  /// (CalibrateReport::imprecise, calibration.hpp); filled by the caller of measureRun, which
+  /// alone calibrated.
+  std::vector<std::string> calibration_warnings;
   bool angular = false;  ///< the drift is an angular velocity (rad/s) instead of m/s
   std::vector<DriftSample> series;
   /// Start (s) of the window of mean_drift and throughput (the scene's outputs.warmup); the
