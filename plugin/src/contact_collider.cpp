@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "rheofeed/narrow_phase.hpp"
+#include "rheofeed/number_format.hpp"
 #include "stage_clock.hpp"
 
 namespace rheofeed {
@@ -49,6 +50,23 @@ ContactCollider::ContactCollider(dWorldID world, FeederSet& feeders, const Setti
         "warm-start patch (patches/0005, dCheckConfiguration(\"ODE_EXT_contact_warm_start\")), "
         "but the linked ODE reports \"" +
         std::string(dGetConfiguration()) + "\"");
+  }
+  const dSurfaceParameters& surface = settings.default_surface;
+  const auto requireSurface = [](bool ok, const char* name, double value, const char* range) {
+    if (ok) return;
+    throw std::invalid_argument("rheofeed::ContactCollider: Settings::default_surface." +
+                                std::string(name) + " = " + formatNumber(value) + " must be " +
+                                range);
+  };
+  requireSurface(surface.mu >= 0, "mu", surface.mu, ">= 0 (dInfinity allowed): not NaN");
+  if (surface.mode & dContactMu2) {
+    requireSurface(surface.mu2 >= 0, "mu2", surface.mu2, ">= 0 (dInfinity allowed): not NaN");
+  }
+  if (surface.mode & dContactBounce) {
+    requireSurface(surface.bounce >= 0 && surface.bounce <= 1, "bounce", surface.bounce,
+                   "in [0, 1]");
+    requireSurface(surface.bounce_vel >= 0 && std::isfinite(surface.bounce_vel), "bounce_vel",
+                   surface.bounce_vel, "finite and >= 0 (m/s)");
   }
   requireFrictionModel(settings.friction, "rheofeed::ContactCollider: Settings::friction");
   settings_.default_surface.mode =
@@ -96,7 +114,8 @@ bool pairBefore(dGeomID a1, dGeomID b1, dGeomID a2, dGeomID b2) {
 }  // namespace
 
 void ContactCollider::collide(dSpaceID space, double time, double step) {
-  rethrowPendingError();           // an error of a manual pass is not lost
+  rethrowPendingError();  // an error of a manual pass is not lost
+  if (!space) throw std::invalid_argument("rheofeed::ContactCollider::collide: space is null");
   feeders_.beginStep(time, step);  // first: a refused time or step leaves everything as it was
   if (settings_.warm_start) keepWarmStarts();
   clearJoints();

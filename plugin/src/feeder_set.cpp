@@ -20,6 +20,8 @@ constexpr int kDiagnosticKinds = 6;
 // A law accepted at |speed| = kMaxSurfaceSpeed may give |c_t| a few roundings above it (the
 // belt's projection and renormalisation): the per-contact test allows this relative slack. It
 // compares |c_t|^2 (no square root per contact; 1e200 is far from overflow).
+// A feeder contact's normal must have |n|^2 within this of 1 (InvalidContact otherwise).
+constexpr double kUnitNormalTolerance = 1e-4;
 constexpr double kContactSpeedLimit = kMaxSurfaceSpeed * (1.0 + 1e-12);
 constexpr double kContactSpeedLimit2 = kContactSpeedLimit * kContactSpeedLimit;
 
@@ -48,7 +50,10 @@ void requireFrictionModel(FrictionModel model, const char* setting) {
       std::string(setting) +
       " = cone needs an ODE with rheofeed's friction-cone patch (patches/0002, "
       "dCheckConfiguration(\"ODE_EXT_friction_cone\")), but the linked ODE reports \"" +
-      dGetConfiguration() + "\": use pyramid, or link the patched ODE (RHEOFEED_ODE=patched)");
+      dGetConfiguration() +
+      "\": use pyramid, or link an ODE built with rheofeed's patches/ (rheofeed's own build "
+      "makes one for its tests and commands, RHEOFEED_ODE=patched, but does not install it: an "
+      "application builds ODE 0.16.2 with those patches itself)");
 }
 
 void requireDoublePrecisionOde() {
@@ -220,6 +225,10 @@ struct FeederSet::Impl {
     const dContactGeom& g = c.geom;
     bool ok = std::isfinite(g.depth) && c.surface.mu >= 0;  // false for NaN mu
     for (int k = 0; k < 3; ++k) ok = ok && std::isfinite(g.pos[k]) && std::isfinite(g.normal[k]);
+    // a unit normal (dCollide's are, to rounding; a zero or scaled one has no tangent plane)
+    const double n2 =
+        g.normal[0] * g.normal[0] + g.normal[1] * g.normal[1] + g.normal[2] * g.normal[2];
+    ok = ok && std::abs(n2 - 1) <= kUnitNormalTolerance;
     if (c.surface.mode & dContactMu2) ok = ok && c.surface.mu2 >= 0;
     return ok;
   }
@@ -253,6 +262,13 @@ struct FeederSet::Impl {
     }
     if (!std::isfinite(g.depth)) {
       out << "contact depth = " << g.depth << " is not finite";
+      return out.str();
+    }
+    if (const double n2 =
+            g.normal[0] * g.normal[0] + g.normal[1] * g.normal[1] + g.normal[2] * g.normal[2];
+        !(std::abs(n2 - 1) <= kUnitNormalTolerance)) {
+      out << "contact normal = (" << g.normal[0] << ", " << g.normal[1] << ", " << g.normal[2]
+          << ") has length " << std::sqrt(n2) << ": must be a unit vector";
       return out.str();
     }
     if (std::isnan(c.surface.mu) || c.surface.mu < 0) {

@@ -131,6 +131,16 @@ TimeProfile TimeProfile::function(std::function<double(double)> scale) {
   return p;
 }
 
+TimeProfile TimeProfile::product(TimeProfile a, TimeProfile b) {
+  if (a.kind_ == Kind::Constant && b.kind_ == Kind::Constant) return constant(a.a_ * b.a_);
+  if (a.kind_ == Kind::Constant && a.a_ == 1.0) return b;
+  if (b.kind_ == Kind::Constant && b.a_ == 1.0) return a;
+  TimeProfile p;
+  p.kind_ = Kind::Product;
+  p.factors_ = {std::move(a), std::move(b)};
+  return p;
+}
+
 double TimeProfile::operator()(double t) const {
   switch (kind_) {
     case Kind::Constant:
@@ -143,6 +153,8 @@ double TimeProfile::operator()(double t) const {
       return (t >= a_ && t < b_) ? 1.0 : 0.0;
     case Kind::Function:
       return function_(t);
+    case Kind::Product:
+      return factors_[0](t) * factors_[1](t);
   }
   return 0.0;
 }
@@ -166,6 +178,9 @@ void TimeProfile::validate(const std::string& where) const {
       break;
     case Kind::Function:
       if (!function_) throw std::invalid_argument(where + ": profile function is empty");
+      break;
+    case Kind::Product:
+      for (const TimeProfile& f : factors_) f.validate(where);
       break;
   }
 }
@@ -243,7 +258,7 @@ LocalDriftStats MotionLaw::localStats() const {
 
 MotionLaw MotionLaw::withProfile(TimeProfile profile) const {
   MotionLaw law = *this;
-  law.profile_ = std::move(profile);
+  law.profile_ = TimeProfile::product(profile_, std::move(profile));
   return law;
 }
 
@@ -262,6 +277,8 @@ double TimeProfile::largestConstantValue() const {
       return 1.0;
     case Kind::Function:
       return 1.0;  // unknown here: checked each step
+    case Kind::Product:
+      return factors_[0].largestConstantValue() * factors_[1].largestConstantValue();
   }
   return 1.0;
 }

@@ -288,6 +288,15 @@ TEST_F(BadInput, ContactsWithBadDataAreRemovedAndReportedByValue) {
       {"nan normal", [](dContact& c) { c.geom.normal[1] = kNan; }, {"normal[1] = nan"}},
       {"inf position", [](dContact& c) { c.geom.pos[2] = kInf; }, {"pos[2] = inf"}},
       {"nan depth", [](dContact& c) { c.geom.depth = kNan; }, {"depth = nan"}},
+      {"zero normal",
+       [](dContact& c) { c.geom.normal[0] = c.geom.normal[1] = c.geom.normal[2] = 0; },
+       {"normal = (0, 0, 0) has length 0", "unit vector"}},
+      {"scaled normal",
+       [](dContact& c) {
+         c.geom.normal[0] = c.geom.normal[1] = 0;
+         c.geom.normal[2] = -5;
+       },
+       {"has length 5"}},
   };
   std::uint64_t removed = 0;
   for (const Case& bad : cases) {

@@ -339,6 +339,43 @@ TEST(ContactCollider, RefusesANonPositiveSpeculativeFraction) {
 
 }  // namespace speculative
 
+// A bad default surface is refused when the collider is made (a NaN mu made every feeder
+// contact invalid, and the parts fell through the feeders), and a null space by collide (it
+// reached dSpaceCollide, which aborts).
+TEST(ContactCollider, RefusesABadDefaultSurfaceAndANullSpace) {
+  dInitODE2(0);
+  dWorldID world = dWorldCreate();
+  FeederSet feeders;
+  const auto refused = [&](void (*spoil)(dSurfaceParameters&), const char* mention) {
+    ContactCollider::Settings s;
+    spoil(s.default_surface);
+    try {
+      ContactCollider collider(world, feeders, s);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what()).find(mention) != std::string::npos;
+    }
+    return false;
+  };
+  EXPECT_TRUE(refused([](dSurfaceParameters& p) { p.mu = NAN; }, "default_surface.mu = nan"));
+  EXPECT_TRUE(refused([](dSurfaceParameters& p) { p.mu = -0.1; }, "default_surface.mu = -0.1"));
+  EXPECT_TRUE(refused(
+      [](dSurfaceParameters& p) {
+        p.mode |= dContactMu2;
+        p.mu2 = NAN;
+      },
+      "default_surface.mu2 = nan"));
+  EXPECT_TRUE(refused(
+      [](dSurfaceParameters& p) {
+        p.mode |= dContactBounce;
+        p.bounce = 1.5;
+      },
+      "default_surface.bounce = 1.5"));
+  EXPECT_FALSE(refused([](dSurfaceParameters& p) { p.mu = dInfinity; }, "mu"));  // allowed
+  ContactCollider collider(world, feeders);
+  EXPECT_THROW(collider.collide(nullptr, 0.0, 0.01), std::invalid_argument);
+  dWorldDestroy(world);
+}
+
 // Warm start (contact_collider.hpp): a column of kCount equal cubes on a static floor, stepped
 // at h = 10 ms with quickstep at kIterations sweeps; the cubes cannot turn (maximum angular speed
 // 0) and the contacts have no friction, so the column can only settle, not topple. From zero,

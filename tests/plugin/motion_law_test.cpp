@@ -182,6 +182,29 @@ TEST(TimeProfileValues, ProfileScalesEveryVelocityOfTheLaw) {
   expectVec(belt.evaluate(0, nullptr).tangentialVelocity({0, 0, 0}, kUp), -0.6, 0.0, 0.0);
 }
 
+// Profiles multiply (the documented "multiplied by profile(t)"): a second profile used to
+// replace the first, so a ramp followed by an on/off window lost the ramp (the C API's
+// rfFeederSetSetRamp then rfFeederSetSetOnOff did).
+TEST(TimeProfileValues, ProfilesOfALawMultiply) {
+  const MotionLaw belt = MotionLaw::belt({1, 0, 0}, 0.3);
+  const MotionLaw six =
+      belt.withProfile(TimeProfile::constant(2)).withProfile(TimeProfile::constant(3));
+  expectVec(six.evaluate(0, nullptr).tangentialVelocity({0, 0, 0}, kUp), 1.8, 0.0, 0.0);
+  EXPECT_FALSE(six.isTimeVarying());
+  // A ramp 0 -> 1 over [0, 2] s, then on for t < 3 s: 0.3 x 0.5 at 1 s, 0.3 at 2.5 s, 0 at 3 s.
+  const MotionLaw started =
+      belt.withProfile(TimeProfile::ramp(0, 2, 0, 1)).withProfile(TimeProfile::onOff(0, 3));
+  expectVec(started.evaluate(1, nullptr).tangentialVelocity({0, 0, 0}, kUp), 0.15, 0.0, 0.0);
+  expectVec(started.evaluate(2.5, nullptr).tangentialVelocity({0, 0, 0}, kUp), 0.3, 0.0, 0.0);
+  expectVec(started.evaluate(3, nullptr).tangentialVelocity({0, 0, 0}, kUp), 0.0, 0.0, 0.0);
+  EXPECT_TRUE(started.isTimeVarying());
+  // Each factor is validated.
+  EXPECT_THROW(belt.withProfile(TimeProfile::onOff(0, 3))
+                   .withProfile(TimeProfile::ramp(2, 1, 0, 1))
+                   .validate("test"),
+               std::invalid_argument);
+}
+
 TEST(TimeProfileValues, TimeVaryingOnlyWhenSomethingDependsOnTime) {
   EXPECT_FALSE(MotionLaw::belt({1, 0, 0}, 0.3).isTimeVarying());
   EXPECT_FALSE(

@@ -141,7 +141,8 @@ class ContactCollider {
     /// Options::record_contacts.
     bool feedback = false;
     /// Surface every contact starts from (the SurfaceCallback may change it): Approx1 friction
-    /// with mu = 0.5.
+    /// with mu = 0.5. The constructor refuses a NaN or negative mu (and mu2 with dContactMu2), a
+    /// bounce outside [0, 1] or a negative bounce_vel (m/s) with dContactBounce.
     dSurfaceParameters default_surface = {
         dContactApprox1, 0.5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
     /// Friction law of every contact (friction_model.hpp), set in default_surface's mode
@@ -196,11 +197,11 @@ class ContactCollider {
   /// world is then stepped with, see FeederSet::beginStep; 0 gives rotating laws'
   /// instantaneous field): empties the joint group, calls feeders.beginStep(time, step),
   /// collides `space` (recursing into sub-spaces) and creates joints. Throws
-  /// std::invalid_argument (from beginStep) for a non-finite time or a bad step. Rethrows the
-  /// first exception thrown inside the pass (by the SurfaceCallback or an allocation) after
-  /// dSpaceCollide has returned, with the joint group and the feeders' records emptied (file
-  /// comment). An error left pending by a manual dSpaceCollide pass is rethrown first, before
-  /// anything is done.
+  /// std::invalid_argument for a null space and (from beginStep) for a non-finite time or a bad
+  /// step. Rethrows the first exception thrown inside the pass (by the SurfaceCallback or an
+  /// allocation) after dSpaceCollide has returned, with the joint group and the feeders'
+  /// records emptied (file comment). An error left pending by a manual dSpaceCollide pass is
+  /// rethrown first, before anything is done.
   void collide(dSpaceID space, double time, double step = 0.0);
   /// Empties the contact joint group (collide does it). Does not clear a pending error.
   void clearJoints();

@@ -81,7 +81,8 @@ enum class AttachOrder {
 
 /// What a diagnostic is about.
 enum class DiagnosticKind {
-  InvalidContact,    ///< non-finite position/normal/depth, or mu NaN or negative: contact removed
+  InvalidContact,    ///< non-finite position/normal/depth, a normal that is not a unit vector
+                     ///< (|n|^2 off 1 by more than 1e-4), or mu NaN or negative: contact removed
   ZeroFriction,      ///< mu = 0 on a feeder contact: ODE ignores motion1 then (contact kept)
   LawNotFinite,      ///< the law (profile, twist function or field) gave a non-finite value,
                      ///< or one beyond the limits of motion_law.hpp: contact left undriven
@@ -100,8 +101,9 @@ struct Diagnostic {
   std::string message;  ///< e.g. "feeder geom 0x55..: contact mu = -0.2 is negative; ..."
 };
 
-/// Per-feeder counters. "last step" is the step before the latest beginStep call's step,
-/// i.e. what the latest completed collision pass did.
+/// Per-feeder counters. "last step": the collision pass since the latest beginStep call
+/// (beginStep sets those two counters to 0; read them after the pass, before the next
+/// beginStep); "all steps": since the feeder was added.
 struct FeederStats {
   int contacts_driven = 0;             ///< feeder contacts given fdir1/motion1 (last step)
   int contacts_undriven = 0;           ///< feeder contacts left with c = 0 (tiny c_rel or bad law)
@@ -161,7 +163,9 @@ class FeederSet {
 
   /// Register `geom` as a feeder with `law`. Throws std::invalid_argument if geom is null,
   /// already registered, the law is invalid (names the value), or the law uses Frame::Body and
-  /// the geom has no body.
+  /// the geom has no body. The set knows feeders by the geom's address and ODE tells it nothing
+  /// of a destroyed geom: remove(geom) before dGeomDestroy(geom), or a new geom that ODE puts at
+  /// the freed address becomes that feeder.
   void add(dGeomID geom, MotionLaw law);
   /// Replace the law of a registered feeder (throws if unregistered or invalid). Parts that
   /// ODE auto-disabled and that touch this feeder are woken at the next collision pass.

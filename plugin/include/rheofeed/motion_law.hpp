@@ -49,6 +49,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "rheofeed/vec3.hpp"
 #include "rheofeed/vibration_drift.hpp"
@@ -113,22 +114,27 @@ class TimeProfile {
   static TimeProfile onOff(double t_on, double t_off = std::numeric_limits<double>::infinity());
   /// s(t) = scale(t), a user function; it is evaluated once per step per feeder.
   static TimeProfile function(std::function<double(double t)> scale);
+  /// s(t) = a(t) b(t): a ramp that starts a feeder times an on/off window that stops it, say.
+  static TimeProfile product(TimeProfile a, TimeProfile b);
 
   /// The scale at time t (s). A user function may return a non-finite value; callers check.
   double operator()(double t) const;
-  /// True when s(t) cannot change with t (only the constant profile).
+  /// True when s(t) cannot change with t (only the constant profile; a product of constants is
+  /// one).
   bool isConstant() const { return kind_ == Kind::Constant; }
   /// Throws std::invalid_argument naming the bad parameter (prefix names where it came from).
   void validate(const std::string& where) const;
   /// The largest |s(t)| known without calling a user function: |scale|, max(|from|, |to|) of a
-  /// ramp, 1 for on/off and for a function profile (checked at every step instead).
+  /// ramp, 1 for on/off and for a function profile (checked at every step instead), the
+  /// product of its factors' for a product.
   double largestConstantValue() const;
 
  private:
-  enum class Kind { Constant, Ramp, OnOff, Function };
+  enum class Kind { Constant, Ramp, OnOff, Function, Product };
   Kind kind_ = Kind::Constant;
   double a_ = 1.0, b_ = 0.0, c_ = 0.0, d_ = 0.0;
   std::function<double(double)> function_;
+  std::vector<TimeProfile> factors_;  // Product: s(t) is their product
 };
 
 class StepLaw;
@@ -187,7 +193,8 @@ class MotionLaw {
   static MotionLaw localVibration(const LocalVibration& vibration,
                                   std::shared_ptr<LocalDriftTable> table);
 
-  /// A copy of this law whose velocities are multiplied by `profile(t)`.
+  /// A copy of this law whose velocities are multiplied by `profile(t)`, on top of any profile
+  /// the law has already (law.withProfile(a).withProfile(b) scales by a(t) b(t)).
   MotionLaw withProfile(TimeProfile profile) const;
 
   Kind kind() const { return kind_; }

@@ -70,7 +70,9 @@ rfFeederSetID rfFeederSetCreateWithOptions(int force_approx1, int attach_order,
 void rfFeederSetDestroy(rfFeederSetID set);
 
 /** Register `geom` with twist v = linear (m/s), w = angular (rad/s) about origin (m):
- *  surface velocity v + w x (p - origin). */
+ *  surface velocity v + w x (p - origin). The set knows feeders by the geom's address:
+ *  rfFeederSetRemove(set, geom) before dGeomDestroy(geom), or a new geom at the freed address
+ *  becomes that feeder (every rfFeederSetAdd* function). */
 int rfFeederSetAddTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
                         const double angular[3], const double origin[3], int frame);
 /** Register `geom` as a belt: `speed` (m/s, negative reverses) along `direction`. */
@@ -124,10 +126,14 @@ int rfFeederSetSetTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
 int rfFeederSetSetBelt(rfFeederSetID set, dGeomID geom, const double direction[3], double speed,
                        int frame);
 
-/** Scale the feeder's law by a linear ramp from `from` at t_start to `to` at t_end (s). */
+/** Scale the feeder's law by a linear ramp from `from` at t_start to `to` at t_end (s).
+ *  Profiles multiply: a ramp then an on/off window (rfFeederSetSetOnOff) gives a ramp that
+ *  switches off; a second ramp multiplies the first. To start over, set the law again
+ *  (rfFeederSetSetTwist, rfFeederSetSetBelt: no profile). */
 int rfFeederSetSetRamp(rfFeederSetID set, dGeomID geom, double t_start, double t_end, double from,
                        double to);
-/** Switch the feeder's law on for t_on <= t < t_off (s), off otherwise. */
+/** Switch the feeder's law on for t_on <= t < t_off (s), off otherwise (multiplies any
+ *  profile the law has, as rfFeederSetSetRamp). */
 int rfFeederSetSetOnOff(rfFeederSetID set, dGeomID geom, double t_on, double t_off);
 
 /** Unregister a feeder. */

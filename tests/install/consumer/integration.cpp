@@ -13,9 +13,13 @@ void addFeeders(dGeomID belt, dGeomID bowl) {
 }
 
 void nearCallback(void*, dGeomID o1, dGeomID o2) {  // the application's own near callback
+  if (!dGeomGetBody(o1) && !dGeomGetBody(o2)) return;  // two static geoms: nothing to move
   dContact contact[8] = {};
   int n = dCollide(o1, o2, 8, &contact[0].geom, sizeof(dContact));
-  for (int i = 0; i < n; ++i) contact[i].surface.mu = 0.5;  // ... the surface as usual
+  for (int i = 0; i < n; ++i) {  // ... the surface as usual; Approx1: mu is a coefficient
+    contact[i].surface.mode = dContactApprox1;
+    contact[i].surface.mu = 0.5;
+  }
   n = feeders.driveContacts(contact, n);  // feeder contacts get fdir1, motion1 (m/s)
   for (int i = 0; i < n; ++i)
     dJointAttach(dJointCreateContact(world, contact_group, &contact[i]), dGeomGetBody(o1),
