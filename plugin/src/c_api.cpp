@@ -257,6 +257,20 @@ int rfFeederSetGetContactsDriven(rfFeederSetID set, dGeomID geom) {
   return rc == rfOK ? driven : rc;
 }
 
+int rfFeederSetGetStats(rfFeederSetID set, dGeomID geom, rfFeederStats* out) {
+  return guarded(set, [&] {
+    if (!out) throw std::invalid_argument("rfFeederSetGetStats: out is a null pointer");
+    const rheofeed::FeederStats& s = set->set.stats(geom);
+    out->contacts_driven = s.contacts_driven;
+    out->contacts_undriven = s.contacts_undriven;
+    out->invalid_contacts = s.invalid_contacts;
+    out->zero_friction = s.zero_friction;
+    out->law_not_finite = s.law_not_finite;
+    out->law_threw = s.law_threw;
+    out->bodies_woken = s.bodies_woken;
+  });
+}
+
 void rfFeederSetSetDiagnosticFunction(rfFeederSetID set, rfDiagnosticFunction* fn, void* user) {
   if (!set) return;
   if (!fn) {

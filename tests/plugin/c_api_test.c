@@ -441,6 +441,7 @@ static void errors(struct Fixture* fx) {
 static void diagnosticsAndBadCalls(struct Fixture* fx) {
   dContact contacts[8];
   struct Seen seen;
+  rfFeederStats before, after;
   rfFeederSetID set = fx->set;
   dGeomID belt = fx->belt, part_geom = fx->part_geom;
   /* Diagnostics: a negative mu on a feeder contact is removed and reported. */
@@ -451,10 +452,18 @@ static void diagnosticsAndBadCalls(struct Fixture* fx) {
   contacts[0].geom.g2 = part_geom;
   contacts[0].geom.normal[2] = 1.0;
   contacts[0].surface.mu = -1.0;
+  CHECK(rfFeederSetGetStats(set, belt, &before) == rfOK);
   CHECK(rfFeederSetDriveContacts(set, contacts, 1) == 0);
   CHECK(seen.count == 1);
   CHECK(strcmp(seen.kind, "invalid_contact") == 0);
   CHECK_MENTIONS(seen.message, "mu = -1");
+  /* ... and counted in the feeder's totals */
+  CHECK(rfFeederSetGetStats(set, belt, &after) == rfOK);
+  CHECK(after.invalid_contacts == before.invalid_contacts + 1);
+  CHECK(after.zero_friction == before.zero_friction);
+  CHECK(rfFeederSetGetStats(set, belt, 0) == rfErrorInvalidArgument);
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "out is a null pointer");
+  CHECK(rfFeederSetGetStats(set, part_geom, &after) == rfErrorInvalidArgument); /* no feeder */
 
   /* A null array with a positive count, or a negative count, is a caller bug: an error code
    * (never the count), a message naming the value, an "invalid_call" diagnostic. */

@@ -167,6 +167,22 @@ int rfFeederSetDriveContacts(rfFeederSetID set, dContact* contacts, int count);
  *  rfError code for an unregistered geom. */
 int rfFeederSetGetContactsDriven(rfFeederSetID set, dGeomID geom);
 
+/** One feeder's counters (rfFeederSetGetStats). "This pass": since the last
+ *  rfFeederSetBeginStep; "in all": since the feeder was added. Counts of contacts. */
+typedef struct rfFeederStats {
+  int contacts_driven;                 /**< given fdir1/motion1 (this pass) */
+  int contacts_undriven;               /**< left with no surface velocity (this pass) */
+  unsigned long long invalid_contacts; /**< removed for bad data (in all) */
+  unsigned long long zero_friction;    /**< with mu = 0: ODE ignores motion1 (in all) */
+  unsigned long long law_not_finite;   /**< left undriven: law value not finite or too large */
+  unsigned long long law_threw;        /**< left undriven: a C++ law threw (in all) */
+  unsigned long long bodies_woken;     /**< disabled parts woken by a law change (in all) */
+} rfFeederStats;
+
+/** Writes `geom`'s counters into `out`: what the diagnostic function reports one by one, as
+ *  totals. Returns rfOK, or a negative rfError code for an unregistered geom or a null `out`. */
+int rfFeederSetGetStats(rfFeederSetID set, dGeomID geom, rfFeederStats* out);
+
 /** Friction models (rfFeederSetSetFrictionModel). */
 enum { rfFrictionPyramid = 0, rfFrictionCone = 1 };
 /** The friction law of this set's feeder contacts: rfFrictionPyramid (stock ODE's per-axis
