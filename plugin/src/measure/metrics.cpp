@@ -318,8 +318,16 @@ class RunMeter : public RunObserver {
     std::vector<double> drift;
     double dz = 0;
     int counted = 0;  // parts in the vertical displacement
+    // Parts inside a fixture at the end are counted lost in the run's totals (RunHealth::
+    // partsLost) though partLost() does not say so (they might still have come out): their
+    // motion inside a fixture is not the feeder's either.
+    std::vector<bool> inside(static_cast<std::size_t>(m_.parts), false);
+    for (const PartEvent& e : sim.health().inside_fixture_now) {
+      if (e.part >= 0 && e.part < m_.parts) inside[static_cast<std::size_t>(e.part)] = true;
+    }
     for (int i = 0; i < m_.parts; ++i) {
-      if (sim.partLost(i)) continue;  // a lost part's motion is not the feeder's
+      // a lost part's motion is not the feeder's
+      if (sim.partLost(i) || inside[static_cast<std::size_t>(i)]) continue;
       ++counted;
       Track& tr = tracks_[static_cast<std::size_t>(i)];
       const Vec3 x = sim.part(i).position;

@@ -163,8 +163,8 @@ struct RunMetrics {
   double warmup = 0;
   /// Mean drift (m/s along d, or rad/s about the axis) over [warmup, end]: total displacement of
   /// the measured parts divided by time, averaged over parts. Parts counted lost
-  /// (Simulation::partLost) are left out: a tunnelled or fallen part's motion is not the
-  /// feeder's.
+  /// (Simulation::partLost, and those inside a fixture at the end: RunHealth::inside_fixture_now)
+  /// are left out: a tunnelled or fallen part's motion is not the feeder's.
   double mean_drift = 0;
   /// 95 % CI half-width over parts (the drift's unit); 0 with fewer than two parts, where it is
   /// not defined (the outputs write null, an empty field or n/a).
