@@ -101,7 +101,15 @@ Plan makePlan(const SceneArgs& args, const std::vector<std::string>& default_met
     for (Method m : methods) {
       if (RunStep s = runStep(scene, m, overrides); s.time_step > coarsest.time_step) coarsest = s;
     }
-    atRunStep(scene, coarsest).validate();
+    try {
+      atRunStep(scene, coarsest).validate();
+    } catch (const std::invalid_argument& e) {
+      // atRunStep names the step solver.time_step: say where it came from when it did not
+      if (!coarsest.from_scene || coarsest.field == "solver.time_step") throw;
+      throw std::invalid_argument(std::string(e.what()) +
+                                  " (checked at h = " + formatNumber(coarsest.time_step) + " s, " +
+                                  coarsest.source() + ": the coarsest step of the planned runs)");
+    }
   } catch (const std::invalid_argument& e) {
     std::string hint;
     if (args.duration_given && !args.warmup_given &&

@@ -3,8 +3,10 @@
 #include "rheofeed/rheofeed.h"
 
 #include <new>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <utility>
 
 #include "rheofeed/feeder_set.hpp"
@@ -12,10 +14,32 @@
 struct rfFeederSet {
   rheofeed::FeederSet set;
   std::string last_error;
+  /// The profiles rfFeederSetSetRamp and rfFeederSetSetOnOff gave a feeder, one of each kind
+  /// (a second ramp or window replaces the first; the two multiply), over the law it had before
+  /// the first of them (`base`). Dropped when the feeder's law is set again or it is removed.
+  struct Profiles {
+    rheofeed::MotionLaw base;
+    std::optional<rheofeed::TimeProfile> ramp, on_off;
+  };
+  std::unordered_map<dGeomID, Profiles> profiles;
   explicit rfFeederSet(const rheofeed::FeederSet::Options& options) : set(options) {}
 };
 
 namespace {
+
+// Gives `geom` its ramp (is_ramp) or its on/off window, replacing the one of that kind it had
+// and keeping the other (rfFeederSet::Profiles).
+void setProfile(rfFeederSet& set, dGeomID geom, rheofeed::TimeProfile profile, bool is_ramp) {
+  auto it = set.profiles.find(geom);
+  rfFeederSet::Profiles p =
+      it != set.profiles.end() ? it->second : rfFeederSet::Profiles{set.set.law(geom), {}, {}};
+  (is_ramp ? p.ramp : p.on_off) = std::move(profile);
+  rheofeed::MotionLaw law = p.base;
+  if (p.ramp) law = law.withProfile(*p.ramp);
+  if (p.on_off) law = law.withProfile(*p.on_off);
+  set.set.setLaw(geom, law);  // throws for a bad profile: nothing changes then
+  set.profiles[geom] = std::move(p);
+}
 
 using rheofeed::Frame;
 using rheofeed::MotionLaw;
@@ -136,12 +160,18 @@ int rfOdeHasFrictionCone(void) {
 
 int rfFeederSetAddTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
                         const double angular[3], const double origin[3], int frame) {
-  return guarded(set, [&] { set->set.add(geom, twistLaw(linear, angular, origin, frame)); });
+  return guarded(set, [&] {
+    set->set.add(geom, twistLaw(linear, angular, origin, frame));
+    set->profiles.erase(geom);
+  });
 }
 
 int rfFeederSetAddBelt(rfFeederSetID set, dGeomID geom, const double direction[3], double speed,
                        int frame) {
-  return guarded(set, [&] { set->set.add(geom, beltLaw(direction, speed, frame)); });
+  return guarded(set, [&] {
+    set->set.add(geom, beltLaw(direction, speed, frame));
+    set->profiles.erase(geom);
+  });
 }
 
 int rfFeederSetAddField(rfFeederSetID set, dGeomID geom, rfFieldFunction* field, void* user,
@@ -155,6 +185,7 @@ int rfFeederSetAddField(rfFeederSetID set, dGeomID geom, rfFieldFunction* field,
       return Vec3{out[0], out[1], out[2]};
     };
     set->set.add(geom, MotionLaw::field(wrapped, time_varying != 0));
+    set->profiles.erase(geom);
   });
 }
 
@@ -165,6 +196,7 @@ int rfFeederSetAddLocalVibration(rfFeederSetID set, dGeomID geom, double frequen
   return guarded(set, [&] {
     set->set.add(geom, localVibrationLaw(frequency, amplitude, torsion_amplitude, axis_origin,
                                          axis_direction, gravity, efficiency));
+    set->profiles.erase(geom);
   });
 }
 
@@ -175,6 +207,7 @@ int rfFeederSetSetLocalVibration(rfFeederSetID set, dGeomID geom, double frequen
   return guarded(set, [&] {
     set->set.setLaw(geom, localVibrationLaw(frequency, amplitude, torsion_amplitude, axis_origin,
                                             axis_direction, gravity, efficiency));
+    set->profiles.erase(geom);
   });
 }
 
@@ -190,31 +223,37 @@ int rfFeederSetSetPartEfficiency(rfFeederSetID set, dBodyID body, double factor)
 
 int rfFeederSetSetTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
                         const double angular[3], const double origin[3], int frame) {
-  return guarded(set, [&] { set->set.setLaw(geom, twistLaw(linear, angular, origin, frame)); });
+  return guarded(set, [&] {
+    set->set.setLaw(geom, twistLaw(linear, angular, origin, frame));
+    set->profiles.erase(geom);
+  });
 }
 
 int rfFeederSetSetBelt(rfFeederSetID set, dGeomID geom, const double direction[3], double speed,
                        int frame) {
-  return guarded(set, [&] { set->set.setLaw(geom, beltLaw(direction, speed, frame)); });
+  return guarded(set, [&] {
+    set->set.setLaw(geom, beltLaw(direction, speed, frame));
+    set->profiles.erase(geom);
+  });
 }
 
 int rfFeederSetSetRamp(rfFeederSetID set, dGeomID geom, double t_start, double t_end, double from,
                        double to) {
   return guarded(set, [&] {
-    const MotionLaw& law = set->set.law(geom);
-    set->set.setLaw(geom, law.withProfile(rheofeed::TimeProfile::ramp(t_start, t_end, from, to)));
+    setProfile(*set, geom, rheofeed::TimeProfile::ramp(t_start, t_end, from, to), true);
   });
 }
 
 int rfFeederSetSetOnOff(rfFeederSetID set, dGeomID geom, double t_on, double t_off) {
-  return guarded(set, [&] {
-    const MotionLaw& law = set->set.law(geom);
-    set->set.setLaw(geom, law.withProfile(rheofeed::TimeProfile::onOff(t_on, t_off)));
-  });
+  return guarded(set,
+                 [&] { setProfile(*set, geom, rheofeed::TimeProfile::onOff(t_on, t_off), false); });
 }
 
 int rfFeederSetRemove(rfFeederSetID set, dGeomID geom) {
-  return guarded(set, [&] { set->set.remove(geom); });
+  return guarded(set, [&] {
+    set->set.remove(geom);
+    set->profiles.erase(geom);
+  });
 }
 
 int rfFeederSetContains(rfFeederSetID set, dGeomID geom) {

@@ -135,9 +135,27 @@ TimeProfile TimeProfile::product(TimeProfile a, TimeProfile b) {
   if (a.kind_ == Kind::Constant && b.kind_ == Kind::Constant) return constant(a.a_ * b.a_);
   if (a.kind_ == Kind::Constant && a.a_ == 1.0) return b;
   if (b.kind_ == Kind::Constant && b.a_ == 1.0) return a;
+  // One flat list of factors (no nesting however many profiles are multiplied in), the
+  // constants folded into one.
   TimeProfile p;
   p.kind_ = Kind::Product;
-  p.factors_ = {std::move(a), std::move(b)};
+  double scale = 1.0;
+  for (TimeProfile* f : {&a, &b}) {
+    if (f->kind_ == Kind::Product) {
+      for (TimeProfile& g : f->factors_) {
+        if (g.kind_ == Kind::Constant) {
+          scale *= g.a_;
+        } else {
+          p.factors_.push_back(std::move(g));
+        }
+      }
+    } else if (f->kind_ == Kind::Constant) {
+      scale *= f->a_;
+    } else {
+      p.factors_.push_back(std::move(*f));
+    }
+  }
+  if (scale != 1.0) p.factors_.push_back(constant(scale));
   return p;
 }
 
@@ -153,8 +171,11 @@ double TimeProfile::operator()(double t) const {
       return (t >= a_ && t < b_) ? 1.0 : 0.0;
     case Kind::Function:
       return function_(t);
-    case Kind::Product:
-      return factors_[0](t) * factors_[1](t);
+    case Kind::Product: {
+      double s = 1.0;
+      for (const TimeProfile& f : factors_) s *= f(t);
+      return s;
+    }
   }
   return 0.0;
 }
@@ -277,8 +298,11 @@ double TimeProfile::largestConstantValue() const {
       return 1.0;
     case Kind::Function:
       return 1.0;  // unknown here: checked each step
-    case Kind::Product:
-      return factors_[0].largestConstantValue() * factors_[1].largestConstantValue();
+    case Kind::Product: {
+      double s = 1.0;
+      for (const TimeProfile& f : factors_) s *= f.largestConstantValue();
+      return s;
+    }
   }
   return 1.0;
 }

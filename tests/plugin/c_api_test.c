@@ -332,6 +332,26 @@ static void profiles(struct Fixture* fx) {
     CHECK((contacts[0].surface.mode & dContactMotion1) == 0);
     CHECK(contacts[0].surface.motion1 == 0.0);
   }
+  /* A new window replaces the feeder's window and keeps multiplying its ramp: on over [0, 10) s,
+   * at 1.5 s the ramp's half speed (the window [5, 6) s is gone). */
+  CHECK(rfFeederSetSetOnOff(set, belt, 0.0, 10.0) == rfOK);
+  CHECK(rfFeederSetBeginStep(set, 1.5) == rfOK);
+  n = dCollide(belt, part_geom, 8, &contacts[0].geom, sizeof(dContact));
+  for (i = 0; i < n; ++i) contacts[i].surface.mu = 0.5;
+  n = rfFeederSetDriveContacts(set, contacts, n);
+  CHECK(n > 0);
+  if (n > 0) CHECK_NEAR(contacts[0].surface.motion1, 0.5 * kSpeed, ROUND_OFF);
+  /* Setting the law again drops both profiles. */
+  {
+    const double x[3] = {1, 0, 0};
+    CHECK(rfFeederSetSetBelt(set, belt, x, kSpeed, rfFrameWorld) == rfOK);
+  }
+  CHECK(rfFeederSetBeginStep(set, 1.5) == rfOK);
+  n = dCollide(belt, part_geom, 8, &contacts[0].geom, sizeof(dContact));
+  for (i = 0; i < n; ++i) contacts[i].surface.mu = 0.5;
+  n = rfFeederSetDriveContacts(set, contacts, n);
+  CHECK(n > 0);
+  if (n > 0) CHECK_NEAR(contacts[0].surface.motion1, kSpeed, ROUND_OFF);
 }
 
 /* A C field function, and a turntable with and without the step. */

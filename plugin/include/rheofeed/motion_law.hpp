@@ -134,7 +134,7 @@ class TimeProfile {
   Kind kind_ = Kind::Constant;
   double a_ = 1.0, b_ = 0.0, c_ = 0.0, d_ = 0.0;
   std::function<double(double)> function_;
-  std::vector<TimeProfile> factors_;  // Product: s(t) is their product
+  std::vector<TimeProfile> factors_;  // Product: s(t) is their product (none a product)
 };
 
 class StepLaw;

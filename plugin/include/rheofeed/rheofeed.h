@@ -126,14 +126,14 @@ int rfFeederSetSetTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
 int rfFeederSetSetBelt(rfFeederSetID set, dGeomID geom, const double direction[3], double speed,
                        int frame);
 
-/** Scale the feeder's law by a linear ramp from `from` at t_start to `to` at t_end (s).
- *  Profiles multiply: a ramp then an on/off window (rfFeederSetSetOnOff) gives a ramp that
- *  switches off; a second ramp multiplies the first. To start over, set the law again
- *  (rfFeederSetSetTwist, rfFeederSetSetBelt: no profile). */
+/** Scale the feeder's law by a linear ramp from `from` at t_start to `to` at t_end (s). A
+ *  feeder has at most one ramp and one on/off window (rfFeederSetSetOnOff): a second ramp
+ *  replaces the first, and the ramp and the window multiply (a ramp that switches off). Setting
+ *  the law again (rfFeederSetSetTwist, rfFeederSetSetBelt, ...) drops both. */
 int rfFeederSetSetRamp(rfFeederSetID set, dGeomID geom, double t_start, double t_end, double from,
                        double to);
-/** Switch the feeder's law on for t_on <= t < t_off (s), off otherwise (multiplies any
- *  profile the law has, as rfFeederSetSetRamp). */
+/** Switch the feeder's law on for t_on <= t < t_off (s), off otherwise; replaces the
+ *  feeder's previous window and multiplies its ramp (rfFeederSetSetRamp). */
 int rfFeederSetSetOnOff(rfFeederSetID set, dGeomID geom, double t_on, double t_off);
 
 /** Unregister a feeder. */

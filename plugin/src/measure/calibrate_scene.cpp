@@ -2,6 +2,7 @@
 // Calibrating what a scene's rheonomic runs need (calibration.hpp: calibrateScene), shared by
 // `rheofeed run` (calibrates what the scene does not give, every launch) and `rheofeed
 // calibrate` (calibrates once and writes the result into a copy of the scene).
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -19,13 +20,23 @@ namespace {
 // few sampled parts differ for good, e.g. nuts lying flat and on edge).
 std::string imprecision(const std::string& what, double value, double ci95,
                         const CalibrateOptions& options) {
-  const double relative = value != 0 ? std::abs(ci95 / value) : HUGE_VAL;
-  if (!(relative > kImpreciseCalibration)) return "";
   std::ostringstream m;
-  m << what << " is known to +-" << std::lround(100 * relative) << " % (95 %), above "
-    << std::lround(100 * kImpreciseCalibration)
+  if (ci95 == 0) {  // statistics.hpp: no interval over fewer than two measured parts
+    m << what << " has no 95 % interval (fewer than two sampled parts were measured): how far "
+      << "it can be trusted is unknown";
+    return m.str();
+  }
+  if (value == 0) {
+    m << what << " is 0: its interval is not a fraction of it, and the runs that use it carry "
+      << "all of that uncertainty";
+    return m.str();
+  }
+  const double relative = std::abs(ci95 / value);
+  if (!(relative > kImpreciseCalibration)) return "";
+  m << what << " is known to +-" << std::lround(std::min(100 * relative, 1e6))
+    << " % (95 %), above " << std::lround(100 * kImpreciseCalibration)
     << " %: the runs that use it carry that uncertainty; more measured cycles narrow it "
-       "(--measure-cycles "
+       "(--measure-cycles, CalibrateOptions::measure_cycles: "
     << formatNumber(options.measure_cycles)
     << " now; four times as many about halve it where the parts' motion over time, not the "
        "few parts sampled, limits it)";

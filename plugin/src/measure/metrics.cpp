@@ -153,6 +153,7 @@ class RunMeter : public RunObserver {
     for (const Fixture& f : scene.fixtures) {
       if (f.law.kind == FeederLaw::Kind::Vibration) {
         m_.drift_models.push_back(f.name + ": " + toString(f.law.drift_model));
+        if (isFullVibration(method)) continue;  // it vibrates: no drift field drives it
         DriftField field;
         field.fixture = f.name;
         field.drift_model = toString(f.law.drift_model);
