@@ -307,51 +307,47 @@ static void driveAndCarry(struct Fixture* fx) {
   CHECK_NEAR(dBodyGetLinearVel(part)[0], kSpeed, 1e-6);
 }
 
+/* The belt's contacts with the part at time t (s), driven; their number (> 0 checked). */
+static int driveBeltAt(struct Fixture* fx, double t, dContact contacts[8]) {
+  int n, i;
+  CHECK(rfFeederSetBeginStep(fx->set, t) == rfOK);
+  n = dCollide(fx->belt, fx->part_geom, 8, &contacts[0].geom, sizeof(dContact));
+  for (i = 0; i < n; ++i) contacts[i].surface.mu = 0.5;
+  n = rfFeederSetDriveContacts(fx->set, contacts, n);
+  CHECK(n > 0);
+  return n;
+}
+
 /* Ramp and on/off profiles on the belt. */
 static void profiles(struct Fixture* fx) {
   dContact contacts[8];
-  int n, i;
   rfFeederSetID set = fx->set;
-  dGeomID belt = fx->belt, part_geom = fx->part_geom;
+  dGeomID belt = fx->belt;
   /* A ramp profile: halfway through, half the speed. */
   CHECK(rfFeederSetSetRamp(set, belt, 1.0, 2.0, 0.0, 1.0) == rfOK);
-  CHECK(rfFeederSetBeginStep(set, 1.5) == rfOK);
-  n = dCollide(belt, part_geom, 8, &contacts[0].geom, sizeof(dContact));
-  CHECK(n > 0);
-  for (i = 0; i < n; ++i) contacts[i].surface.mu = 0.5;
-  n = rfFeederSetDriveContacts(set, contacts, n);
-  CHECK(n > 0);
-  if (n > 0) CHECK_NEAR(contacts[0].surface.motion1, 0.5 * kSpeed, ROUND_OFF);
+  if (driveBeltAt(fx, 1.5, contacts) > 0) {
+    CHECK_NEAR(contacts[0].surface.motion1, 0.5 * kSpeed, ROUND_OFF);
+  }
+  /* An on/off window multiplies it: off at 1.5 s. */
   CHECK(rfFeederSetSetOnOff(set, belt, 5.0, 6.0) == rfOK);
-  CHECK(rfFeederSetBeginStep(set, 1.5) == rfOK);
-  n = dCollide(belt, part_geom, 8, &contacts[0].geom, sizeof(dContact));
-  for (i = 0; i < n; ++i) contacts[i].surface.mu = 0.5;
-  n = rfFeederSetDriveContacts(set, contacts, n);
-  CHECK(n > 0);
-  if (n > 0) {
+  if (driveBeltAt(fx, 1.5, contacts) > 0) {
     CHECK((contacts[0].surface.mode & dContactMotion1) == 0);
     CHECK(contacts[0].surface.motion1 == 0.0);
   }
   /* A new window replaces the feeder's window and keeps multiplying its ramp: on over [0, 10) s,
    * at 1.5 s the ramp's half speed (the window [5, 6) s is gone). */
   CHECK(rfFeederSetSetOnOff(set, belt, 0.0, 10.0) == rfOK);
-  CHECK(rfFeederSetBeginStep(set, 1.5) == rfOK);
-  n = dCollide(belt, part_geom, 8, &contacts[0].geom, sizeof(dContact));
-  for (i = 0; i < n; ++i) contacts[i].surface.mu = 0.5;
-  n = rfFeederSetDriveContacts(set, contacts, n);
-  CHECK(n > 0);
-  if (n > 0) CHECK_NEAR(contacts[0].surface.motion1, 0.5 * kSpeed, ROUND_OFF);
+  if (driveBeltAt(fx, 1.5, contacts) > 0) {
+    CHECK_NEAR(contacts[0].surface.motion1, 0.5 * kSpeed, ROUND_OFF);
+  }
   /* Setting the law again drops both profiles. */
   {
     const double x[3] = {1, 0, 0};
     CHECK(rfFeederSetSetBelt(set, belt, x, kSpeed, rfFrameWorld) == rfOK);
   }
-  CHECK(rfFeederSetBeginStep(set, 1.5) == rfOK);
-  n = dCollide(belt, part_geom, 8, &contacts[0].geom, sizeof(dContact));
-  for (i = 0; i < n; ++i) contacts[i].surface.mu = 0.5;
-  n = rfFeederSetDriveContacts(set, contacts, n);
-  CHECK(n > 0);
-  if (n > 0) CHECK_NEAR(contacts[0].surface.motion1, kSpeed, ROUND_OFF);
+  if (driveBeltAt(fx, 1.5, contacts) > 0) {
+    CHECK_NEAR(contacts[0].surface.motion1, kSpeed, ROUND_OFF);
+  }
 }
 
 /* A C field function, and a turntable with and without the step. */
