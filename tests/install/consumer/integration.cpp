@@ -13,7 +13,8 @@ void addFeeders(dGeomID belt, dGeomID bowl) {
 }
 
 void nearCallback(void*, dGeomID o1, dGeomID o2) {  // the application's own near callback
-  if (!dGeomGetBody(o1) && !dGeomGetBody(o2)) return;  // two static geoms: nothing to move
+  // two static geoms: nothing to move
+  if (!dGeomGetBody(o1) && !dGeomGetBody(o2)) return;
   dContact contact[8] = {};
   int n = dCollide(o1, o2, 8, &contact[0].geom, sizeof(dContact));
   for (int i = 0; i < n; ++i) {  // ... the surface as usual; Approx1: mu is a coefficient
