@@ -27,6 +27,17 @@ struct rfFeederSet {
 
 namespace {
 
+// Gives `geom` a new law (registering it first when `add`): any ramp or window of the C API's
+// goes with the old one.
+void newLaw(rfFeederSet& set, dGeomID geom, rheofeed::MotionLaw law, bool add) {
+  if (add) {
+    set.set.add(geom, std::move(law));
+  } else {
+    set.set.setLaw(geom, std::move(law));
+  }
+  set.profiles.erase(geom);
+}
+
 // Gives `geom` its ramp (is_ramp) or its on/off window, replacing the one of that kind it had
 // and keeping the other (rfFeederSet::Profiles).
 void setProfile(rfFeederSet& set, dGeomID geom, rheofeed::TimeProfile profile, bool is_ramp) {
@@ -160,18 +171,12 @@ int rfOdeHasFrictionCone(void) {
 
 int rfFeederSetAddTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
                         const double angular[3], const double origin[3], int frame) {
-  return guarded(set, [&] {
-    set->set.add(geom, twistLaw(linear, angular, origin, frame));
-    set->profiles.erase(geom);
-  });
+  return guarded(set, [&] { newLaw(*set, geom, twistLaw(linear, angular, origin, frame), true); });
 }
 
 int rfFeederSetAddBelt(rfFeederSetID set, dGeomID geom, const double direction[3], double speed,
                        int frame) {
-  return guarded(set, [&] {
-    set->set.add(geom, beltLaw(direction, speed, frame));
-    set->profiles.erase(geom);
-  });
+  return guarded(set, [&] { newLaw(*set, geom, beltLaw(direction, speed, frame), true); });
 }
 
 int rfFeederSetAddField(rfFeederSetID set, dGeomID geom, rfFieldFunction* field, void* user,
@@ -184,8 +189,7 @@ int rfFeederSetAddField(rfFeederSetID set, dGeomID geom, rfFieldFunction* field,
       field(user, pa, na, t, out);
       return Vec3{out[0], out[1], out[2]};
     };
-    set->set.add(geom, MotionLaw::field(wrapped, time_varying != 0));
-    set->profiles.erase(geom);
+    newLaw(*set, geom, MotionLaw::field(wrapped, time_varying != 0), true);
   });
 }
 
@@ -194,9 +198,10 @@ int rfFeederSetAddLocalVibration(rfFeederSetID set, dGeomID geom, double frequen
                                  const double axis_origin[3], const double axis_direction[3],
                                  const double gravity[3], double efficiency) {
   return guarded(set, [&] {
-    set->set.add(geom, localVibrationLaw(frequency, amplitude, torsion_amplitude, axis_origin,
-                                         axis_direction, gravity, efficiency));
-    set->profiles.erase(geom);
+    newLaw(*set, geom,
+           localVibrationLaw(frequency, amplitude, torsion_amplitude, axis_origin, axis_direction,
+                             gravity, efficiency),
+           true);
   });
 }
 
@@ -205,9 +210,10 @@ int rfFeederSetSetLocalVibration(rfFeederSetID set, dGeomID geom, double frequen
                                  const double axis_origin[3], const double axis_direction[3],
                                  const double gravity[3], double efficiency) {
   return guarded(set, [&] {
-    set->set.setLaw(geom, localVibrationLaw(frequency, amplitude, torsion_amplitude, axis_origin,
-                                            axis_direction, gravity, efficiency));
-    set->profiles.erase(geom);
+    newLaw(*set, geom,
+           localVibrationLaw(frequency, amplitude, torsion_amplitude, axis_origin, axis_direction,
+                             gravity, efficiency),
+           false);
   });
 }
 
@@ -223,18 +229,12 @@ int rfFeederSetSetPartEfficiency(rfFeederSetID set, dBodyID body, double factor)
 
 int rfFeederSetSetTwist(rfFeederSetID set, dGeomID geom, const double linear[3],
                         const double angular[3], const double origin[3], int frame) {
-  return guarded(set, [&] {
-    set->set.setLaw(geom, twistLaw(linear, angular, origin, frame));
-    set->profiles.erase(geom);
-  });
+  return guarded(set, [&] { newLaw(*set, geom, twistLaw(linear, angular, origin, frame), false); });
 }
 
 int rfFeederSetSetBelt(rfFeederSetID set, dGeomID geom, const double direction[3], double speed,
                        int frame) {
-  return guarded(set, [&] {
-    set->set.setLaw(geom, beltLaw(direction, speed, frame));
-    set->profiles.erase(geom);
-  });
+  return guarded(set, [&] { newLaw(*set, geom, beltLaw(direction, speed, frame), false); });
 }
 
 int rfFeederSetSetRamp(rfFeederSetID set, dGeomID geom, double t_start, double t_end, double from,
