@@ -37,15 +37,19 @@ int checkCommand(const SceneArgs& args) {
     std::fputs(formatHazards(found, "  ").c_str(), stdout);
     hazards += static_cast<int>(found.size());
   }
-  for (const Fixture& f : plan.scene.fixtures) {
+  for (std::size_t i = 0; i < plan.scene.fixtures.size(); ++i) {
+    const Fixture& f = plan.scene.fixtures[i];
     if (f.law.kind != FeederLaw::Kind::Vibration) continue;
-    Scene one;
-    one.fixtures = {f};
+    const std::string stale = staleCalibration(plan.scene, static_cast<int>(i));
     const std::string missing =
-        needsCalibration(one) ? ", which the scene does not give: `rheofeed run` calibrates it at "
-                                "every launch, `rheofeed calibrate " +
-                                    args.scene + " --out NEW.json` saves it"
-                              : std::string();
+        !stale.empty() ? ", but " + stale +
+                             ": `rheofeed run` calibrates it again at every launch, "
+                             "`rheofeed calibrate " +
+                             args.scene + " --out NEW.json` saves the new one"
+        : lacksCalibration(f.law) ? ", which the scene does not give: `rheofeed run` calibrates it "
+                                    "at every launch, `rheofeed calibrate " +
+                                        args.scene + " --out NEW.json` saves it"
+                                  : std::string();
     std::printf("note: fixture '%s' vibrates; rheonomic runs use drift model %s%s\n",
                 f.name.c_str(), toString(f.law.drift_model), missing.c_str());
   }

@@ -247,7 +247,8 @@ int runCommand(const RunArgs& args) {
     for (const PlannedRun& r : plan.runs)
       any_rheonomic = any_rheonomic || !isFullVibration(r.method);
     Scene calibrated = plan.scene;
-    std::vector<std::string> calibration_warnings;  // CalibrateReport::imprecise, into each run
+    // CalibrateReport::stale and ::imprecise, into each rheonomic run's JSON
+    std::vector<std::string> calibration_warnings;
     const bool calibrating = any_rheonomic && needsCalibration(calibrated);
     noteIgnoredCycleOptions("rheofeed run", args.cycles_given, calibrating,
                             args.calibrate.classical);
@@ -257,7 +258,9 @@ int runCommand(const RunArgs& args) {
         if (!isFullVibration(r.method)) options.rheonomic_time_step = r.scene.solver.time_step;
       }
       const CalibrateReport c = calibrateScene(calibrated, options, "rheofeed run", stderr);
-      calibration_warnings = c.imprecise;
+      calibration_warnings = c.stale;
+      calibration_warnings.insert(calibration_warnings.end(), c.imprecise.begin(),
+                                  c.imprecise.end());
       std::fprintf(stderr,
                    "rheofeed run: calibration took %.1f s CPU; `rheofeed calibrate %s --out "
                    "NEW.json` saves it so that runs of NEW.json start at once\n",

@@ -46,6 +46,16 @@ void expectSame(const Twist& a, const Twist& b, const std::string& what) {
   expectSame(a.angular, b.angular, what + ".angular");
   expectSame(a.origin, b.origin, what + ".origin");
 }
+void expectSame(const Vibration& a, const Vibration& b, const std::string& what) {
+  EXPECT_EQ(a.amplitude, b.amplitude) << what;
+  EXPECT_EQ(a.frequency, b.frequency) << what;
+  expectSame(a.direction, b.direction, what + ".direction");
+  EXPECT_EQ(a.phase, b.phase) << what;
+  EXPECT_EQ(a.torsion_amplitude, b.torsion_amplitude) << what;
+  expectSame(a.axis_origin, b.axis_origin, what + ".axis_origin");
+  expectSame(a.axis_direction, b.axis_direction, what + ".axis_direction");
+}
+
 void expectSame(const Distribution& a, const Distribution& b, const std::string& what) {
   EXPECT_EQ(a.mean, b.mean) << what;
   EXPECT_EQ(a.stddev, b.stddev) << what;
@@ -102,14 +112,15 @@ void expectSameScene(const Scene& a, const Scene& b) {
     expectSame(la.drift, lb.drift, w + ".drift");
     expectSame(la.belt_direction, lb.belt_direction, w + ".belt_direction");
     EXPECT_EQ(la.belt_speed, lb.belt_speed) << w;
-    const Vibration &va = la.vibration, &vb = lb.vibration;
-    EXPECT_EQ(va.amplitude, vb.amplitude) << w;
-    EXPECT_EQ(va.frequency, vb.frequency) << w;
-    expectSame(va.direction, vb.direction, w + ".vibration.direction");
-    EXPECT_EQ(va.phase, vb.phase) << w;
-    EXPECT_EQ(va.torsion_amplitude, vb.torsion_amplitude) << w;
-    expectSame(va.axis_origin, vb.axis_origin, w + ".axis_origin");
-    expectSame(va.axis_direction, vb.axis_direction, w + ".axis_direction");
+    expectSame(la.vibration, lb.vibration, w + ".vibration");
+    ASSERT_EQ(la.calibrated_for.has_value(), lb.calibrated_for.has_value()) << w;
+    if (la.calibrated_for) {
+      expectSame(la.calibrated_for->vibration, lb.calibrated_for->vibration,
+                 w + ".calibrated_for.vibration");
+      expectSame(la.calibrated_for->gravity, lb.calibrated_for->gravity,
+                 w + ".calibrated_for.gravity");
+      EXPECT_EQ(la.calibrated_for->mu, lb.calibrated_for->mu) << w;
+    }
     EXPECT_EQ(la.has_calibrated_drift, lb.has_calibrated_drift) << w;
     expectSame(la.calibrated_drift, lb.calibrated_drift, w + ".calibrated_drift");
     EXPECT_EQ(la.drift_model, lb.drift_model) << w;
@@ -239,6 +250,8 @@ Scene everyFieldScene() {
   bowl.law.calibrated_drift = {{0, 0, 0.0019}, {0, 0, 0.4}, {-3, 0, 0}};
   bowl.law.drift_model = DriftModel::LocalSampled;            // the calibrated drift kept beside it
   bowl.law.efficiency = {0.8123456789012345, 1, 1.0 / 3, 0};  // boxes, balls, pins, nuts
+  bowl.law.calibrated_for = CalibrationBasis{v, {0.1, 0, -9.7}, 0.45};
+  bowl.law.calibrated_for->vibration.amplitude = 2.5e-4;  // calibrated for another amplitude
   s.fixtures.push_back(bowl);
 
   Fixture ground;

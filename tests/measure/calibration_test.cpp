@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "rheofeed/number_format.hpp"
 #include "scene_builders.hpp"
 
 namespace rheofeed::scene {
@@ -104,6 +105,103 @@ TEST(WithCalibration, StoresTheDriftAndSwitchesTheFixtureToIt) {
   Calibration wrong = c;
   wrong.fixture = 3;
   EXPECT_THROW(withCalibration(s, wrong), std::invalid_argument);
+}
+
+// What a calibration was measured for (FeederLaw::calibrated_for): a scene whose vibration,
+// gravity or friction changed since (an edited file, a sweep over the amplitude) must not keep
+// answering with it.
+TEST(StaleCalibration, AChangedVibrationGravityOrMuMakesTheCalibrationStaleNamingBothValues) {
+  const Scene s = hoppingTrack();
+  const Scene calibrated = withCalibration(s, calibrateClassical(s, 0));
+  ASSERT_TRUE(calibrated.fixtures[0].law.calibrated_for.has_value());
+  EXPECT_EQ(staleCalibration(calibrated, 0), "");
+  EXPECT_FALSE(needsCalibration(calibrated));
+  EXPECT_NO_THROW(rheonomicLaw(calibrated, 0));
+
+  Scene louder = calibrated;
+  louder.fixtures[0].law.vibration.amplitude = 2 * kAmplitude;
+  const std::string why = staleCalibration(louder, 0);
+  EXPECT_NE(why.find("calibrated drift was measured for another feeder"), std::string::npos) << why;
+  EXPECT_NE(why.find("amplitude (m) " + formatNumber(kAmplitude) + " when calibrated, " +
+                     formatNumber(2 * kAmplitude) + " now"),
+            std::string::npos)
+      << why;
+  EXPECT_EQ(why.find("frequency"), std::string::npos) << why;  // only what changed
+  EXPECT_TRUE(needsCalibration(louder));
+  try {
+    rheonomicLaw(louder, 0);
+    ADD_FAILURE() << "a stale calibrated drift was used";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("fixtures[0] ('track')"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("amplitude (m)"), std::string::npos) << e.what();
+  }
+
+  Scene moon = calibrated;
+  moon.gravity = {0, 0, -1.62};
+  EXPECT_NE(staleCalibration(moon, 0).find("gravity (m/s^2) [0, 0, -9.81] when calibrated, "
+                                           "[0, 0, -1.62] now"),
+            std::string::npos)
+      << staleCalibration(moon, 0);
+  Scene slippery = calibrated;
+  slippery.material.mu = 0.2;
+  EXPECT_NE(staleCalibration(slippery, 0).find("mu 0.5 when calibrated, 0.2 now"),
+            std::string::npos)
+      << staleCalibration(slippery, 0);
+
+  Scene shifted = calibrated;  // a phase does not change a steady drift
+  shifted.fixtures[0].law.vibration.phase = 1;
+  EXPECT_EQ(staleCalibration(shifted, 0), "");
+  Scene local = louder;  // the local law uses no calibration
+  local.fixtures[0].law.drift_model = DriftModel::Local;
+  EXPECT_EQ(staleCalibration(local, 0), "");
+  Scene by_hand = louder;  // a drift given without its basis cannot be checked
+  by_hand.fixtures[0].law.calibrated_for.reset();
+  EXPECT_EQ(staleCalibration(by_hand, 0), "");
+}
+
+TEST(StaleCalibration, LocalSampledEfficienciesKeepWhatTheyWereMeasuredFor) {
+  Scene s = hoppingTrack();
+  EfficiencyCalibration c;
+  c.fixture = 0;
+  c.family = 0;
+  c.efficiency = 0.8;
+  const Scene sampled = withEfficiency(s, c);
+  EXPECT_EQ(staleCalibration(sampled, 0), "");
+  Scene faster = sampled;
+  faster.fixtures[0].law.vibration.frequency = 60;
+  const std::string why = staleCalibration(faster, 0);
+  EXPECT_NE(why.find("part efficiency factors were measured for another feeder: frequency (Hz) "
+                     "50 when calibrated, 60 now"),
+            std::string::npos)
+      << why;
+}
+
+TEST(CalibrateScene, CalibratesAStaleCalibrationAgainAndSaysWhy) {
+  Scene s = hoppingTrack();
+  s.fixtures[0].law.drift_model = DriftModel::CalibratedDrift;
+  std::FILE* log = std::tmpfile();
+  ASSERT_NE(log, nullptr);
+  CalibrateOptions options;
+  options.classical = true;
+  calibrateScene(s, options, "test", log);
+  const double first = s.fixtures[0].law.calibrated_drift.linear.x;
+  // At 60 Hz (throw number 3.4 * 1.44 = 4.9) the drift is the classical model's there.
+  s.fixtures[0].law.vibration.frequency = 60;
+  const CalibrateReport again = calibrateScene(s, options, "test", log);
+  EXPECT_EQ(again.calibrated, 1);
+  EXPECT_EQ(again.given, 0);
+  ASSERT_EQ(again.stale.size(), 1u);
+  EXPECT_NE(again.stale[0].find("fixture 'track': its calibrated drift was measured for another "
+                                "feeder: frequency (Hz) 50 when calibrated, 60 now"),
+            std::string::npos)
+      << again.stale[0];
+  EXPECT_EQ(staleCalibration(s, 0), "");
+  Scene edited = hoppingTrack();
+  edited.fixtures[0].law.vibration.frequency = 60;
+  const double expected = calibrateClassical(edited, 0).value;
+  EXPECT_EQ(s.fixtures[0].law.calibrated_drift.linear.x, expected);
+  EXPECT_NE(expected, first);
+  std::fclose(log);
 }
 
 TEST(CalibrateScene, CalibratesOnlyTheFixturesWhoseDriftModelTakesACalibration) {

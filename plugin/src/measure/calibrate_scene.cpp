@@ -66,7 +66,12 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
       ++report.local;
       continue;
     }
-    if (!lacksCalibration(scene.fixtures[i].law) && !options.force) {
+    const std::string stale = staleCalibration(scene, fixture);
+    if (!stale.empty()) {
+      const std::string message = "fixture '" + name + "': " + stale;
+      std::fprintf(log, "%s: warning: %s; calibrating it again\n", label.c_str(), message.c_str());
+      report.stale.push_back(message);
+    } else if (!lacksCalibration(scene.fixtures[i].law) && !options.force) {
       std::fprintf(log, "%s: fixture '%s': drift model %s, given by the scene\n", label.c_str(),
                    name.c_str(), toString(law.drift_model));
       ++report.given;

@@ -518,6 +518,11 @@ MotionLaw rheonomicLaw(const Scene& scene, int fixture) {
   const Fixture& f = scene.fixtures[static_cast<std::size_t>(fixture)];
   const FeederLaw& law = f.law;
   const std::string where = "fixtures[" + std::to_string(fixture) + "] ('" + f.name + "')";
+  if (const std::string stale = staleCalibration(scene, fixture); !stale.empty()) {
+    throw std::invalid_argument(where + ": " + stale +
+                                " (calibrate again: `rheofeed calibrate`, calibrateScene; or use "
+                                "drift_model local)");
+  }
   switch (law.kind) {
     case FeederLaw::Kind::None:
       return MotionLaw{};
@@ -568,9 +573,47 @@ bool lacksCalibration(const FeederLaw& law) {
   return false;
 }
 
+std::string staleCalibration(const Scene& scene, int fixture) {
+  const FeederLaw& law = scene.fixtures.at(static_cast<std::size_t>(fixture)).law;
+  if (law.kind != FeederLaw::Kind::Vibration || law.drift_model == DriftModel::Local ||
+      lacksCalibration(law) || !law.calibrated_for) {
+    return "";
+  }
+  const CalibrationBasis& was = *law.calibrated_for;
+  const Vibration& v = law.vibration;
+  std::string changed;
+  const auto compare = [&](const char* what, const std::string& then, const std::string& now) {
+    if (then == now) return;
+    changed += (changed.empty() ? "" : ", ") + std::string(what) + " " + then +
+               " when calibrated, " + now + " now";
+  };
+  const auto vec = [](const Vec3& a) {
+    return "[" + formatNumber(a.x) + ", " + formatNumber(a.y) + ", " + formatNumber(a.z) + "]";
+  };
+  // Compared as printed, to 6 significant digits: a round trip's last-digit noise is no change,
+  // an edit of the scene is.
+  compare("amplitude (m)", formatNumber(was.vibration.amplitude), formatNumber(v.amplitude));
+  compare("frequency (Hz)", formatNumber(was.vibration.frequency), formatNumber(v.frequency));
+  compare("direction", vec(was.vibration.direction), vec(v.direction));
+  compare("torsion amplitude (rad)", formatNumber(was.vibration.torsion_amplitude),
+          formatNumber(v.torsion_amplitude));
+  compare("axis origin (m)", vec(was.vibration.axis_origin), vec(v.axis_origin));
+  compare("axis direction", vec(was.vibration.axis_direction), vec(v.axis_direction));
+  compare("gravity (m/s^2)", vec(was.gravity), vec(scene.gravity));
+  compare("mu", formatNumber(was.mu), formatNumber(scene.material.mu));
+  if (changed.empty()) return "";
+  return std::string("its ") +
+         (law.drift_model == DriftModel::CalibratedDrift ? "calibrated drift was"
+                                                         : "part efficiency factors were") +
+         " measured for another feeder: " + changed;
+}
+
 bool needsCalibration(const Scene& scene) {
-  for (const Fixture& f : scene.fixtures) {
-    if (lacksCalibration(f.law)) return true;
+  for (std::size_t i = 0; i < scene.fixtures.size(); ++i) {
+    if (lacksCalibration(scene.fixtures[i].law) ||
+        !staleCalibration(scene, static_cast<int>(i)).empty()) {
+      return true;
+    }
   }
   return false;
 }

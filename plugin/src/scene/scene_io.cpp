@@ -349,7 +349,7 @@ void readLaw(const json& v, const std::string& path, FeederLaw& law,
          "for a fixture that does not move)");
   }
   const std::string kind = given;
-  for (const char* key : {"calibrated_drift", "drift_model", "efficiency"}) {
+  for (const char* key : {"calibrated_drift", "drift_model", "efficiency", "calibrated_for"}) {
     if (o.has(key) && (kind == "drift" || kind == "belt")) {
       fail(o.at(key), std::string("only a vibration or screw law has a ") +
                           (key == std::string("efficiency") ? "part efficiency" : key));
@@ -370,6 +370,16 @@ void readLaw(const json& v, const std::string& path, FeederLaw& law,
     kind == "vibration" ? readVibration(body, law.vibration) : readScrew(body, law.vibration);
     body.finish();
     if (o.opt("calibrated_drift", law.calibrated_drift)) law.has_calibrated_drift = true;
+    if (const json* basis = o.find("calibrated_for")) {
+      Object b(*basis, o.at("calibrated_for"));
+      CalibrationBasis& was = law.calibrated_for.emplace();
+      Object vibration(b.require("vibration"), b.at("vibration"));
+      readVibration(vibration, was.vibration);
+      vibration.finish();
+      b.req("gravity", was.gravity);
+      b.req("mu", was.mu, Range::NonNegative);
+      b.finish();
+    }
     // Without drift_model: a law that carries a calibrated drift keeps using it (files written
     // before the local law behave as before); any other uses the local law.
     law.drift_model = law.has_calibrated_drift ? DriftModel::CalibratedDrift : DriftModel::Local;

@@ -102,6 +102,16 @@ ojson toJson(const Fixture::Geom& g) {
   return out;
 }
 
+ojson toJson(const Vibration& v) {
+  return ojson{{"amplitude", v.amplitude},
+               {"frequency", v.frequency},
+               {"direction", toJson(v.direction)},
+               {"phase_rad", v.phase},
+               {"torsion_amplitude_rad", v.torsion_amplitude},
+               {"axis_origin", toJson(v.axis_origin)},
+               {"axis_direction", toJson(v.axis_direction)}};
+}
+
 // A law's efficiency factors: an object keyed by part family name when the names are unique
 // and not empty (readable), else an array in the order of the parts.
 ojson efficiencyJson(const std::vector<double>& factors, const std::vector<PartSpec>& parts) {
@@ -126,17 +136,15 @@ ojson toJson(const FeederLaw& law, const std::vector<PartSpec>& parts) {
       return ojson{
           {"belt", ojson{{"direction", toJson(law.belt_direction)}, {"speed", law.belt_speed}}}};
     case FeederLaw::Kind::Vibration: {
-      const Vibration& v = law.vibration;
-      ojson out{{"vibration", ojson{{"amplitude", v.amplitude},
-                                    {"frequency", v.frequency},
-                                    {"direction", toJson(v.direction)},
-                                    {"phase_rad", v.phase},
-                                    {"torsion_amplitude_rad", v.torsion_amplitude},
-                                    {"axis_origin", toJson(v.axis_origin)},
-                                    {"axis_direction", toJson(v.axis_direction)}}}};
+      ojson out{{"vibration", toJson(law.vibration)}};
       out["drift_model"] = toString(law.drift_model);
       if (law.has_calibrated_drift) out["calibrated_drift"] = toJson(law.calibrated_drift);
       if (!law.efficiency.empty()) out["efficiency"] = efficiencyJson(law.efficiency, parts);
+      if (law.calibrated_for) {
+        out["calibrated_for"] = ojson{{"vibration", toJson(law.calibrated_for->vibration)},
+                                      {"gravity", toJson(law.calibrated_for->gravity)},
+                                      {"mu", law.calibrated_for->mu}};
+      }
       return out;
     }
   }

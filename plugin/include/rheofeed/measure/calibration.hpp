@@ -63,7 +63,9 @@ Calibration calibrateBySampling(const Scene& scene, int fixture,
 Calibration calibrateClassical(const Scene& scene, int fixture);
 
 /// A copy of `scene` whose vibrating fixture carries `calibration` as its calibrated drift
-/// and drift_model calibrated_drift: rheonomic methods then use it.
+/// and drift_model calibrated_drift: rheonomic methods then use it. Its calibrated_for is set
+/// from `scene` (the fixture's vibration, the scene's gravity and mu): pass the scene that was
+/// calibrated, and a later edit of them makes the drift stale (staleCalibration).
 Scene withCalibration(Scene scene, const Calibration& calibration);
 
 /// How calibrateEfficiency runs (issue 8: the part's own efficiency under the local law).
@@ -112,7 +114,8 @@ EfficiencyCalibration calibrateEfficiency(const Scene& scene, int fixture, int f
 
 /// A copy of `scene` whose fixture `calibration.fixture` uses drift_model local_sampled with
 /// `calibration.efficiency` as the factor of `calibration.family` (the other families keep
-/// theirs, 1 when the fixture had none). Throws std::invalid_argument for a bad index.
+/// theirs, 1 when the fixture had none), its calibrated_for set from `scene` as withCalibration
+/// does. Throws std::invalid_argument for a bad index.
 Scene withEfficiency(Scene scene, const EfficiencyCalibration& calibration);
 
 /// How the drift fields are found.
@@ -144,16 +147,20 @@ struct CalibrateReport {
   /// value (a calibrated drift, or a part family's efficiency): the runs that use it carry that
   /// uncertainty. Also printed on the log as a warning, with the longer sampling that narrows it.
   std::vector<std::string> imprecise;
+  /// One message per fixture whose calibration the scene gave but measured for another feeder
+  /// (staleCalibration): calibrated again. Also printed on the log as a warning.
+  std::vector<std::string> stale;
 };
 
 /// A calibration is reported imprecise (CalibrateReport::imprecise) when its 95 % half-width is
 /// above this fraction of its value.
 inline constexpr double kImpreciseCalibration = 0.1;
 
-/// Calibrates the vibrating fixtures of `scene` that need it (all but the local-law ones with
-/// options.force) and stores the results in it: calibrated_drift by calibrateBySampling (or
-/// calibrateClassical) and withCalibration, local_sampled by calibrateEfficiency per part family
-/// and withEfficiency. Each calibration is announced on `log` before it starts
+/// Calibrates the vibrating fixtures of `scene` that need it (lacking or stale calibrations;
+/// all but the local-law ones with options.force) and stores the results in it: calibrated_drift by
+/// calibrateBySampling (or calibrateClassical) and withCalibration, local_sampled by
+/// calibrateEfficiency per part family and withEfficiency. Each calibration is announced on `log`
+/// before it starts
 /// ("<label>: calibrating fixture ...") and its result printed after. Throws what the
 /// calibration throws (std::invalid_argument for a scene it cannot calibrate).
 CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,

@@ -152,9 +152,9 @@ struct RunMetrics {
   std::vector<std::string> drift_models;
   /// The same fixtures with the values their drift model used (efficiencies, calibrated drift).
   std::vector<DriftField> drift_fields;
-  /// The calibrations of the scene's drift fields that were reported imprecise before the run
-  /// (CalibrateReport::imprecise, calibration.hpp); filled by the caller of measureRun, which
-  /// alone calibrated.
+  /// The calibrations of the scene's drift fields that were found stale and redone, or reported
+  /// imprecise, before the run (CalibrateReport::stale and ::imprecise, calibration.hpp); filled
+  /// by the caller of measureRun, which alone calibrated.
   std::vector<std::string> calibration_warnings;
   bool angular = false;  ///< the drift is an angular velocity (rad/s) instead of m/s
   std::vector<DriftSample> series;

@@ -103,6 +103,16 @@ const char* toString(DriftModel model);
 /// The model named `name` (as toString writes it); false if there is none.
 bool parseDriftModel(const std::string& name, DriftModel& model);
 
+/// What a feeder's calibrated drift or efficiency factors were measured for: the vibration and
+/// the scene's gravity and friction at the time (withCalibration, withEfficiency set it; scene
+/// files keep it as "calibrated_for"). A calibration is stale when the scene's now differ
+/// (staleCalibration): it would answer for another feeder.
+struct CalibrationBasis {
+  Vibration vibration;
+  Vec3 gravity{0, 0, -9.81};  ///< (m/s^2, world)
+  double mu = 0;              ///< the material's friction coefficient (dimensionless)
+};
+
 /// Largest part efficiency factor (dimensionless), as FeederSet::setPartEfficiency accepts.
 constexpr double kMaxPartEfficiency = kMaxEfficiency;
 
@@ -137,6 +147,9 @@ struct FeederLaw {
   /// agree on each family's factor (a `local` feeder counts as 1); Scene::validate refuses
   /// feeders that disagree.
   std::vector<double> efficiency;
+  /// What calibrated_drift and efficiency were measured for (CalibrationBasis); none: not
+  /// known (a drift given by hand, or a scene file written before it was kept), never stale.
+  std::optional<CalibrationBasis> calibrated_for;
 };
 
 /// A fixture: static geometry, optionally a feeder. All its geoms move together in a full
@@ -340,8 +353,8 @@ LocalVibration localVibration(const Vibration& vibration, const Vec3& gravity, d
 /// (MotionLaw::localVibration of localVibration(vibration, scene.gravity, scene.material.mu),
 /// on the process's shared drift table LocalDriftTable::shared()) or its calibrated drift twist.
 /// Throws std::invalid_argument naming the fixture when the index is out of range, a
-/// calibrated_drift model has no calibrated drift, or a local_sampled model has no efficiency
-/// factors ("run the calibration first").
+/// calibrated_drift model has no calibrated drift, a local_sampled model has no efficiency
+/// factors ("run the calibration first"), or the calibration is stale (staleCalibration).
 MotionLaw rheonomicLaw(const Scene& scene, int fixture);
 
 /// True when `law` is a vibration whose drift model (DriftModel) lacks its data for a rheonomic
@@ -349,7 +362,17 @@ MotionLaw rheonomicLaw(const Scene& scene, int fixture);
 /// local law needs none). rheonomicLaw refuses such a law.
 bool lacksCalibration(const FeederLaw& law);
 
-/// True when a rheonomic run of `scene` needs a calibration first (a fixture lacksCalibration).
+/// Why the calibration that fixture `fixture`'s drift model uses (its calibrated drift, or its
+/// efficiency factors under local_sampled) no longer fits `scene`: the fields of its
+/// CalibrationBasis that differ from the fixture's vibration and the scene's gravity and mu
+/// now, each with both values ("its calibrated drift was measured for another feeder:
+/// amplitude (m) 0.0005 when calibrated, 0.0008 now"); "" when it
+/// fits, when the law uses no calibration, or when its basis is not known. Phase is not
+/// compared (it does not change a steady drift).
+std::string staleCalibration(const Scene& scene, int fixture);
+
+/// True when a rheonomic run of `scene` needs a calibration first (a fixture lacksCalibration,
+/// or its calibration is stale: staleCalibration).
 bool needsCalibration(const Scene& scene);
 
 /// Sets `model` on every vibrating fixture of `scene`, dropping the efficiency factors of the
