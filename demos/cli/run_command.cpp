@@ -312,11 +312,14 @@ int runCommand(const RunArgs& args) {
       const RunHealth& h = r.health;
       char ci[32] = "n/a";  // no confidence interval over fewer than two parts
       if (ci95Defined(r.drift_parts)) std::snprintf(ci, sizeof ci, "%.5f", r.mean_drift_ci95);
-      char drift[32] = "n/a";  // no part measured
+      char drift[32] = "n/a", height[32] = "n/a";  // no part measured
       if (r.drift_parts > 0) std::snprintf(drift, sizeof drift, "%.5f", r.mean_drift);
-      std::printf("| %s | %.3g | %d | %s | %s | %.4f | %.2f | %.2f | %.4f | %d | %.1f %% |\n",
-                  toString(m), r.time_step, r.parts, drift, ci, r.vertical_displacement,
-                  r.throughput, r.cpu_seconds, r.real_time_factor, h.partsLost(),
+      if (r.displacement_parts > 0) {
+        std::snprintf(height, sizeof height, "%.4f", r.vertical_displacement);
+      }
+      std::printf("| %s | %.3g | %d | %s | %s | %s | %.2f | %.2f | %.4f | %d | %.1f %% |\n",
+                  toString(m), r.time_step, r.parts, drift, ci, height, r.throughput, r.cpu_seconds,
+                  r.real_time_factor, h.partsLost(),
                   100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps));
       std::fflush(stdout);
       if (r.drift_parts == 0 && r.feeder.exit_times.empty()) {

@@ -60,6 +60,7 @@ RunMetrics run() {
   r.mean_drift = 0.0234567891;
   r.mean_drift_ci95 = 0.0012345678;
   r.vertical_displacement = -0.0004;
+  r.displacement_parts = 12;
   r.throughput = 1.5;
   r.parts = 12;
   r.drift_parts = 12;
@@ -154,15 +155,34 @@ TEST(SummaryJson, OnePartHasNoConfidenceInterval) {
   EXPECT_NE(row.find(",1,0.012345679,,"), std::string::npos) << row;  // parts, drift, no ci95
 }
 
-// Twelve parts spawned, none measured (all lost, or spawned beyond the exit): no mean drift and
-// no interval - null, not a 0 +- 0 that reads as a feeder standing still.
+// Twelve parts spawned, none measured (all lost, or spawned beyond the exit): no mean drift, no
+// interval and no vertical displacement - null, not a 0 +- 0 that reads as a feeder standing
+// still.
 TEST(SummaryJson, NoPartMeasuredHasNoMeanDrift) {
   RunMetrics r = run();
   r.drift_parts = 0;
+  r.displacement_parts = 0;
   const json j = json::parse(summaryJson(r));
   EXPECT_TRUE(j["mean_drift"].is_null());
   EXPECT_TRUE(j["mean_drift_ci95"].is_null());
+  EXPECT_TRUE(j["vertical_displacement_m"].is_null());
   EXPECT_EQ(j["parts"], 12);
+}
+
+// A sample with no part in it (none spawned yet, or all gone) has no mean drift and no mean
+// height: empty fields, not 0 m/s at 0 m, which a plot would draw as parts standing on z = 0.
+TEST(SeriesCsv, ASampleWithNoPartHasNoDriftAndNoHeight) {
+  RunMetrics r = run();
+  r.series[0].parts = 0;
+  const auto rows = csvRows(seriesCsv(r));
+  ASSERT_EQ(rows.size(), 3u);
+  ASSERT_EQ(rows[1].size(), 12u);
+  EXPECT_EQ(rows[1][1], "0");
+  EXPECT_EQ(rows[1][2], "");   // mean drift
+  EXPECT_EQ(rows[1][3], "");   // ci95
+  EXPECT_EQ(rows[1][4], "");   // mean height
+  EXPECT_EQ(rows[1][5], "1");  // the counts are still counts
+  EXPECT_NE(rows[2][2], "");   // the next sample has its parts
 }
 
 TEST(SummaryJson, ParsesToTheRunMetricsWritten) {

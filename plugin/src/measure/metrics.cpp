@@ -349,6 +349,7 @@ class RunMeter : public RunObserver {
     m_.mean_drift_ci95 = ci95(drift);
     m_.drift_parts = static_cast<int>(drift.size());
     m_.vertical_displacement = counted ? dz / counted : 0;
+    m_.displacement_parts = counted;
     const double window = m_.simulated_seconds - out_.warmup;
     m_.throughput = window > 0 ? exited_after_warmup_ / window : 0;
   }

@@ -23,12 +23,17 @@ std::string seriesCsv(const RunMetrics& run) {
        "lost_too_fast,lost_left_feeder\n";
   char line[256];
   for (const DriftSample& d : run.series) {
-    // the spread of one part (or none) has no confidence interval: the field stays empty
-    char ci[32] = "";
+    // No part measured has no mean, and the spread of one part (or none) no confidence
+    // interval: those fields stay empty (gnuplot skips them; a reader sees no value, not 0).
+    char drift[32] = "", ci[32] = "", height[32] = "";
+    if (d.parts > 0) {
+      std::snprintf(drift, sizeof drift, "%.8g", d.mean_velocity);
+      std::snprintf(height, sizeof height, "%.8g", d.mean_height);
+    }
     if (ci95Defined(d.parts)) std::snprintf(ci, sizeof ci, "%.8g", d.ci95);
-    std::snprintf(line, sizeof line, "%.6f,%d,%.8g,%s,%.8g,%d,%d,%d,%d,%d,%d,%d\n", d.time, d.parts,
-                  d.mean_velocity, ci, d.mean_height, d.exited, d.fell, d.through_fixture,
-                  d.out_of_bounds, d.nonfinite, d.too_fast, d.left_feeder);
+    std::snprintf(line, sizeof line, "%.6f,%d,%s,%s,%s,%d,%d,%d,%d,%d,%d,%d\n", d.time, d.parts,
+                  drift, ci, height, d.exited, d.fell, d.through_fixture, d.out_of_bounds,
+                  d.nonfinite, d.too_fast, d.left_feeder);
     s << line;
   }
   return s.str();
@@ -166,7 +171,8 @@ std::string summaryJson(const RunMetrics& r) {
   j["mean_drift"] = r.drift_parts > 0 ? OrderedJson(r.mean_drift) : OrderedJson();
   j["mean_drift_ci95"] =
       ci95Defined(r.drift_parts) ? OrderedJson(r.mean_drift_ci95) : OrderedJson();
-  j["vertical_displacement_m"] = r.vertical_displacement;
+  j["vertical_displacement_m"] =
+      r.displacement_parts > 0 ? OrderedJson(r.vertical_displacement) : OrderedJson();
   j["throughput_parts_per_s"] = r.throughput;
   j["cpu_seconds"] = r.cpu_seconds;
   j["simulated_seconds"] = r.simulated_seconds;

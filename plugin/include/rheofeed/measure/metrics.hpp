@@ -174,9 +174,11 @@ struct RunMetrics {
   /// or n/a), and with fewer than two no confidence interval.
   int drift_parts = 0;
   double vertical_displacement = 0;  ///< mean z change of the parts not lost since they spawned (m)
-  double throughput = 0;             ///< parts per second through the exit plane (after warmup)
-  int parts = 0;                     ///< spawned parts
-  double cpu_seconds = 0;            ///< process CPU time of the run
+  /// Parts vertical_displacement is the mean over (0: none was left to measure, and it is 0).
+  int displacement_parts = 0;
+  double throughput = 0;   ///< parts per second through the exit plane (after warmup)
+  int parts = 0;           ///< spawned parts
+  double cpu_seconds = 0;  ///< process CPU time of the run
   double simulated_seconds = 0;
   /// CPU time / simulated time (dimensionless; < 1 is faster than real time).
   double real_time_factor = 0;

@@ -53,7 +53,8 @@ std::vector<std::string> writeFeederOutputs(const FeederMetrics& feeder,
 /// direction, m/s, and its 95 % half-width; for an angular drift mean_drift_radps,ci95_radps, rad/s
 /// about its axis),mean_height_m,exited, then the parts lost so far by kind (cumulative counts,
 /// RunHealth): lost_fell,lost_through_fixture,lost_out_of_bounds,lost_nonfinite,lost_too_fast,
-/// lost_left_feeder.
+/// lost_left_feeder. A sample with no part measured has empty mean and height fields (no value,
+/// not 0); one with fewer than two an empty ci95.
 std::string seriesCsv(const RunMetrics& run);
 
 /// One-line JSON summary of a run: all scalar fields; "scene_source" (RunMetrics::scene_file, or
@@ -68,8 +69,8 @@ std::string seriesCsv(const RunMetrics& run);
 /// "feeder" object (feederJson); and a "local_law" object (RunHealth::local_law: feeders,
 /// contacts, wall_contacts, cells_computed, model_runs, model_cpu_s (s); corners_at_start from
 /// RunHealth::local_law_corners_at_start). Numbers are written in their shortest form that reads
-/// back exactly; a number that is not finite, a mean drift with no part measured and a 95 %
-/// interval over fewer than two parts are null.
+/// back exactly; a number that is not finite, a mean drift or vertical displacement with no
+/// part measured and a 95 % interval over fewer than two parts are null.
 std::string summaryJson(const RunMetrics& run);
 
 /// Writes <stem>.csv, <stem>.json and, when gnuplot is available, <stem>.png (mean drift vs time
