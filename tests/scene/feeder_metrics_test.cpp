@@ -301,6 +301,28 @@ TEST(FeederMetrics, FamiliesAreCountedSeparatelyAndSpheresSaidMeaningless) {
   EXPECT_EQ(r.feeder.exit_times.size(), 22u);
 }
 
+// Two families may share a name; the outputs must still tell them apart: the second goes by
+// "cubes[1]" in the feeder metrics (and so in the part events and drift fields, familyKeys).
+TEST(FeederMetrics, FamiliesThatShareANameAreToldApartByTheirIndex) {
+  Scene s = dropScene({0, 0, -1});
+  s.duration = 0.6;
+  s.parts[0].count = 3;
+  PartSpec twin = s.parts[0];
+  twin.count = 2;
+  s.parts.push_back(twin);
+  EXPECT_EQ(familyKeys(s.parts),
+            (std::vector<std::string>{s.parts[0].name, s.parts[0].name + "[1]"}));
+  const RunMetrics r = measureRun(s, Method::ReferenceRheonomic);
+  ASSERT_EQ(r.feeder.families.size(), 2u);
+  EXPECT_EQ(r.feeder.families[0].name, s.parts[0].name);
+  EXPECT_EQ(r.feeder.families[1].name, s.parts[0].name + "[1]");
+  EXPECT_EQ(r.feeder.families[0].spawned, 3);
+  EXPECT_EQ(r.feeder.families[1].spawned, 2);
+  // Unique already: unchanged; a name taken by an earlier suffixed one is suffixed too.
+  EXPECT_EQ(uniqueNames({"a", "a[1]", "b"}), (std::vector<std::string>{"a", "a[1]", "b"}));
+  EXPECT_EQ(uniqueNames({"a", "a", "a[1]"}), (std::vector<std::string>{"a", "a[1]", "a[1][2]"}));
+}
+
 TEST(FeederMetrics, NoPartReachingTheExitIsSaid) {
   Scene s = dropScene({0, 0, -1});
   s.duration = 0.1;  // shorter than the 0.175 s fall

@@ -150,6 +150,7 @@ class RunMeter : public RunObserver {
     m_.method = method;
     m_.time_step = h_;
     m_.seed = scene.seed;
+    const std::vector<std::string> family_keys = familyKeys(scene.parts);
     for (const Fixture& f : scene.fixtures) {
       if (f.law.kind == FeederLaw::Kind::Vibration) {
         m_.drift_models.push_back(f.name + ": " + toString(f.law.drift_model));
@@ -159,7 +160,7 @@ class RunMeter : public RunObserver {
         field.drift_model = toString(f.law.drift_model);
         if (f.law.drift_model == DriftModel::LocalSampled) {
           for (std::size_t k = 0; k < f.law.efficiency.size() && k < scene.parts.size(); ++k) {
-            field.efficiency.emplace_back(scene.parts[k].name, f.law.efficiency[k]);
+            field.efficiency.emplace_back(family_keys[k], f.law.efficiency[k]);
           }
         }
         if (f.law.drift_model == DriftModel::CalibratedDrift && f.law.has_calibrated_drift) {
@@ -172,9 +173,10 @@ class RunMeter : public RunObserver {
     FeederMetrics& feeder = m_.feeder;
     feeder.exit_plane = out_.exit_plane;
     feeder.up = upDirection(scene.gravity);
-    for (const PartSpec& spec : scene.parts) {
+    for (std::size_t k = 0; k < scene.parts.size(); ++k) {
+      const PartSpec& spec = scene.parts[k];
       FamilyExits f;
-      f.name = spec.name;
+      f.name = family_keys[k];
       f.shape = spec.shape;
       f.orientation_meaningful = spec.shape != Shape::Kind::Sphere;
       feeder.families.push_back(f);

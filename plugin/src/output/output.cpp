@@ -73,19 +73,12 @@ std::string jsonNumber(double x) {
 
 namespace {
 
-// The JSON keys of the families: the name, or "name[k]" when an earlier family has that name.
-std::vector<std::string> familyKeys(const FeederMetrics& f) {
-  std::vector<std::string> keys;
-  std::set<std::string> seen;
-  for (std::size_t k = 0; k < f.families.size(); ++k) {
-    std::string key = f.families[k].name;
-    if (!seen.insert(key).second) {
-      key += "[" + std::to_string(k) + "]";
-      seen.insert(key);
-    }
-    keys.push_back(key);
-  }
-  return keys;
+// The families' keys in the JSON and CSV: their names (familyKeys made a run's unique), made
+// unique again for metrics filled by hand.
+std::vector<std::string> familyNames(const FeederMetrics& f) {
+  std::vector<std::string> names;
+  for (const FamilyExits& family : f.families) names.push_back(family.name);
+  return uniqueNames(names);
 }
 
 // A family name as a file name part: letters, digits, '-' and '_' kept, others '_'.
@@ -125,7 +118,7 @@ std::string orientationCsv(const FeederMetrics& feeder) {
   s << "family,shape,spawned,exited,removed_without_exit,lost_before_exit,orientation_meaningful";
   for (int a = 0; a < kUpAxisCount; ++a) s << "," << toString(static_cast<UpAxis>(a));
   s << "\n";
-  const std::vector<std::string> keys = familyKeys(feeder);
+  const std::vector<std::string> keys = familyNames(feeder);
   for (std::size_t k = 0; k < feeder.families.size(); ++k) {
     const FamilyExits& f = feeder.families[k];
     std::string name = keys[k];  // CSV: a name with a comma or quote is quoted
@@ -153,7 +146,7 @@ OrderedJson feederJsonValue(const FeederMetrics& f) {
                     {"rate_per_min", w.rate_per_min},
                     {"cumulative_exits", w.cumulative}});
   }
-  const std::vector<std::string> keys = familyKeys(f);
+  const std::vector<std::string> keys = familyNames(f);
   OrderedJson families = OrderedJson::object(), orientation = OrderedJson::object();
   for (std::size_t k = 0; k < f.families.size(); ++k) {
     const FamilyExits& fam = f.families[k];
@@ -245,7 +238,7 @@ std::vector<std::string> writeFeederOutputs(const FeederMetrics& feeder,
     written.push_back(exits_png);
   }
 
-  const std::vector<std::string> keys = familyKeys(feeder);
+  const std::vector<std::string> keys = familyNames(feeder);
   std::set<std::string> used;
   for (std::size_t k = 0; k < feeder.families.size(); ++k) {
     const FamilyExits& f = feeder.families[k];

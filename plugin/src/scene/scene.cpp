@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -628,6 +629,26 @@ void overrideDriftModel(Scene& scene, DriftModel model) {
 
 std::vector<double> partEfficiencies(const Scene& scene) {
   return localEfficiencies(scene.fixtures, scene.parts.size(), scene.parts);
+}
+
+std::vector<std::string> uniqueNames(const std::vector<std::string>& names) {
+  std::vector<std::string> keys;
+  std::set<std::string> seen;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    std::string key = names[k];
+    if (!seen.insert(key).second) {
+      key += "[" + std::to_string(k) + "]";
+      seen.insert(key);
+    }
+    keys.push_back(key);
+  }
+  return keys;
+}
+
+std::vector<std::string> familyKeys(const std::vector<PartSpec>& parts) {
+  std::vector<std::string> names;
+  for (const PartSpec& p : parts) names.push_back(p.name);
+  return uniqueNames(names);
 }
 
 std::vector<PartInstance> drawParts(const Scene& scene) {

@@ -593,7 +593,7 @@ void PartSimulation::trackCrossings(std::size_t i, const Vec3& from, const Vec3&
 }
 
 const std::string& PartSimulation::familyName(std::size_t i) const {
-  return scene_.parts.at(static_cast<std::size_t>(instances_.at(i).spec)).name;
+  return family_keys_.at(static_cast<std::size_t>(instances_.at(i).spec));
 }
 
 void PartSimulation::recordEvent(std::size_t i, const char* key, const std::string& what,

@@ -85,6 +85,7 @@ class PartSimulation : public Simulation {
   void markNonFinite(int index);
 
   const Scene scene_;
+  const std::vector<std::string> family_keys_ = familyKeys(scene_.parts);  // familyName
   RunHealth health_;
   /// Filled by the engine's constructor (appliedSolver).
   AppliedSolver applied_;

@@ -86,7 +86,7 @@ std::vector<int> partFamilies(const Scene& scene);
 
 /// Per part family (one PartSpec): how many parts and how they left through the exit.
 struct FamilyExits {
-  std::string name;  ///< PartSpec::name
+  std::string name;  ///< its PartSpec::name, "name[k]" when repeated (familyKeys, scene.hpp)
   Shape::Kind shape = Shape::Kind::Box;
   int spawned = 0;               ///< parts of this family spawned during the run
   int exited = 0;                ///< crossed the exit plane
@@ -129,7 +129,8 @@ struct FeederMetrics {
 struct DriftField {
   std::string fixture;      ///< Fixture::name
   std::string drift_model;  ///< "local", "local_sampled" or "calibrated_drift"
-  /// local_sampled: each part family's efficiency (dimensionless), as "family name", value;
+  /// local_sampled: each part family's efficiency (dimensionless), as family name (familyKeys,
+  /// scene.hpp: "name[k]" when repeated), value;
   /// empty for the other models.
   std::vector<std::pair<std::string, double>> efficiency;
   /// calibrated_drift: the constant drift twist (Twist: m/s, rad/s about the origin, m; world

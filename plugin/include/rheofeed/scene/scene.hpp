@@ -399,4 +399,13 @@ struct PartInstance {
 /// All parts of the scene in spawn order (mesh parts get their inertia from the mesh).
 std::vector<PartInstance> drawParts(const Scene& scene);
 
+/// The name each part family goes by in a run's outputs (part events, drift fields, feeder
+/// metrics and the files named after a family), indexed like `parts`: its PartSpec::name, or
+/// "name[k]" (k its index) when an earlier family has that name, so that no two are alike
+/// (uniqueNames of the names).
+std::vector<std::string> familyKeys(const std::vector<PartSpec>& parts);
+/// `names` with each name that an earlier one already took suffixed by its index, "name[k]";
+/// names that are already unique are returned unchanged.
+std::vector<std::string> uniqueNames(const std::vector<std::string>& names);
+
 }  // namespace rheofeed::scene

@@ -36,7 +36,7 @@ struct ContactTotals {
 /// One part counted by RunHealth as lost or sunk: which, when, where and how.
 struct PartEvent {
   int part = -1;        ///< the part's index (spawn order)
-  std::string family;   ///< the part's family: PartSpec::name of its entry in Scene::parts
+  std::string family;   ///< the part's family: its name in the outputs (familyKeys, scene.hpp)
   double time = 0;      ///< simulated time of the step that found it (s); for "inside_fixture":
                         ///< the step it went into the fixture it is in (position and velocity
                         ///< are its state now)
