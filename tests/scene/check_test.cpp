@@ -336,6 +336,55 @@ TEST(SceneCheck, CoarseFullVibrationStepFires) {
       ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::CoarseVibrationStep).empty());
 }
 
+// A unit slip in the vibration (millimetres given as metres, degrees as radians) drives the
+// feeder at hundreds of g; a real feeder's few g pass.
+TEST(SceneCheck, AnAmplitudeInMillimetresGivenAsMetresIsAnExtremeVibration) {
+  const double w = 2 * kPi * 50;
+  Scene real = vibratingTrackScene(0.2e-3, 50);  // 0.2 mm at 50 Hz: 19.7 m/s^2, 2 g
+  EXPECT_TRUE(
+      ofKind(checkScene(real, Method::OdeRheonomic), Hazard::Kind::ExtremeVibration).empty());
+  Scene slip = vibratingTrackScene(0.2, 50);  // "0.2" meant in mm
+  const std::vector<Hazard> h =
+      ofKind(checkScene(slip, Method::OdeRheonomic), Hazard::Kind::ExtremeVibration);
+  ASSERT_EQ(h.size(), 1u);
+  EXPECT_NEAR(h[0].value, 0.2 * w * w, 1e-9 * h[0].value);  // A w^2 = 19739 m/s^2
+  EXPECT_NEAR(h[0].limit, kMaxFeederAcceleration * 9.81, 1e-9);
+  EXPECT_EQ(h[0].where, "fixtures[0].law.vibration.amplitude");
+  EXPECT_NE(h[0].message.find("(2012 g: amplitude 0.2 m, 50 Hz)"), std::string::npos) << h[0].message;
+  EXPECT_NE(h[0].message.find("in mm given as m"), std::string::npos) << h[0].message;
+  // The largest amplitude at 50 g and 50 Hz: 50 * 9.81 / w^2 = 4.97 mm.
+  EXPECT_NE(h[0].safe_setting.find("amplitude <= 0.00497 m at 50 Hz"), std::string::npos)
+      << h[0].safe_setting;
+  EXPECT_EQ(toString(h[0].kind), std::string("extreme_vibration"));
+}
+
+TEST(SceneCheck, ATorsionInDegreesGivenAsRadiansIsAnExtremeVibration) {
+  Scene s = vibratingTrackScene(0, 50);  // torsion only, about the z axis through the origin
+  Vibration& v = s.fixtures[0].law.vibration;
+  v.torsion_amplitude = 0.5;  // "0.5" meant in degrees
+  v.axis_direction = {0, 0, 1};
+  v.axis_origin = {0, 0, 0};
+  const std::vector<Hazard> h =
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::ExtremeVibration);
+  ASSERT_EQ(h.size(), 1u) << formatHazards(checkScene(s, Method::OdeRheonomic));
+  EXPECT_EQ(h[0].where, "fixtures[0].law.vibration.torsion_amplitude");
+  // theta w^2 r at the track's farthest corner from the axis.
+  double reach = 0;
+  for (const Fixture::Geom& g : s.fixtures[0].geoms) {
+    for (int sx : {-1, 1}) {
+      for (int sy : {-1, 1}) {
+        const double x = g.pose.position.x + sx * 0.5 * g.shape.size.x;
+        const double y = g.pose.position.y + sy * 0.5 * g.shape.size.y;
+        reach = std::max(reach, std::hypot(x, y));
+      }
+    }
+  }
+  const double w = 2 * kPi * 50;
+  EXPECT_NEAR(h[0].value, 0.5 * w * w * reach, 1e-9 * h[0].value);
+  v.torsion_amplitude = 0.05 * kPi / 180;  // a real torsion: 8.8 g at the corner 1 m out
+  EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::ExtremeVibration).empty());
+}
+
 TEST(SceneCheck, SpawnInsideAFixtureAndBelowTheRemovalHeightFire) {
   Scene s;
   s.fixtures.push_back(floorBox(0.02));

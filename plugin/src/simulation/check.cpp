@@ -132,6 +132,8 @@ const char* toString(Hazard::Kind kind) {
       return "mass_ratio";
     case Hazard::Kind::CoarseVibrationStep:
       return "coarse_vibration_step";
+    case Hazard::Kind::ExtremeVibration:
+      return "extreme_vibration";
     case Hazard::Kind::SpawnInsideFixture:
       return "spawn_inside_fixture";
     case Hazard::Kind::SpawnBelowRemoval:
@@ -165,6 +167,7 @@ std::vector<Hazard> checkScene(const Scene& scene, Method method) {
   checkFlushWalls(c, out);
   checkMassRatio(c, out);
   checkCoarseVibrationStep(c, out);
+  checkExtremeVibration(c, out);
   checkHighRestitution(c, out);
   for (std::size_t i = 0; i < scene.parts.size(); ++i) {
     checkSpawnStream(c, i, out);

@@ -77,7 +77,8 @@ void checkTunnelling(const CheckContext& c, std::vector<Hazard>& out) {
   // turns it off): a part that moves more than a quarter of its smallest half extent in a step
   // is swept, and gets contacts across the gap before it arrives; its travel per step is no
   // hazard then. What the sweep cannot see (an obstacle edge thinner than the gaps between a
-  // part's corner rays) is what the run's own loss counters report.
+  // part's corner rays) is what the run's own loss counters report (check.hpp and the README
+  // say the check is made for the reference engine and ODE without speculative contacts).
   if (c.ode && c.scene.solver.speculative_contacts.value_or(true)) return;
   const auto [speed, source] = expectedSpeed(c);
   // Semi-implicit Euler: x+ = x + h (v + g h), so one step moves a part by h (v + g h).
@@ -250,6 +251,54 @@ void checkCoarseVibrationStep(const CheckContext& c, std::vector<Hazard>& out) {
           "solver.time_step <= " + fmt(1.0 / (kMinStepsPerCycle * law.vibration.frequency)) + " s";
       out.push_back(hz);
     }
+  }
+}
+
+void checkExtremeVibration(const CheckContext& c, std::vector<Hazard>& out) {
+  const double g = c.g > 0 ? c.g : 9.81;
+  for (std::size_t f = 0; f < c.scene.fixtures.size(); ++f) {
+    const FeederLaw& law = c.scene.fixtures[f].law;
+    if (law.kind != FeederLaw::Kind::Vibration) continue;
+    const Vibration& v = law.vibration;
+    const double w = 2 * kPi * v.frequency;
+    double reach = 0;  // the fixture's farthest point from the torsion axis (m)
+    if (v.torsion_amplitude > 0) {
+      for (const GeomInfo& gi : c.geoms) {
+        if (gi.f != f || !gi.bounds.bounded) continue;
+        reach = std::max(reach, radiusFromAxis(gi.bounds, v.axis_origin, v.axis_direction));
+      }
+    }
+    const double translation = v.amplitude * w * w, torsion = v.torsion_amplitude * w * w * reach;
+    const double peak = std::hypot(translation, torsion);
+    const double limit = kMaxFeederAcceleration * g;
+    if (!(peak > limit)) continue;
+    const std::string at = idx("fixtures", f) + ".law.vibration";
+    Hazard hz;
+    hz.kind = Hazard::Kind::ExtremeVibration;
+    hz.value = peak;
+    hz.limit = limit;
+    hz.where = translation >= torsion ? at + ".amplitude" : at + ".torsion_amplitude";
+    std::ostringstream m;
+    m << "fixture '" << c.scene.fixtures[f].name << "' vibrates with a peak acceleration of "
+      << fmt(peak) << " m/s^2 (" << std::lround(peak / g) << " g: amplitude " << fmt(v.amplitude)
+      << " m";
+    if (v.torsion_amplitude > 0) {
+      m << ", torsion " << fmt(v.torsion_amplitude) << " rad at " << mm(reach) << " from the axis";
+    }
+    m << ", " << fmt(v.frequency) << " Hz); vibratory feeders run at a few g (throw numbers 1 to "
+      << "5): is a length in mm given as m, or an angle in degrees as rad? (the scene's units "
+         "are m and rad, or *_deg)";
+    hz.message = m.str();
+    std::ostringstream s;
+    s << "a peak acceleration <= " << fmt(kMaxFeederAcceleration) << " g: ";
+    if (translation >= torsion) {
+      s << at << ".amplitude <= " << fmt(limit / (w * w)) << " m at " << fmt(v.frequency) << " Hz";
+    } else {
+      s << at << ".torsion_amplitude <= " << fmt(limit / (w * w * reach)) << " rad at "
+        << fmt(v.frequency) << " Hz";
+    }
+    hz.safe_setting = s.str();
+    out.push_back(hz);
   }
 }
 

@@ -157,6 +157,7 @@ void checkTunnelling(const CheckContext& c, std::vector<Hazard>& out);
 void checkFlushWalls(const CheckContext& c, std::vector<Hazard>& out);
 void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out);
 void checkCoarseVibrationStep(const CheckContext& c, std::vector<Hazard>& out);
+void checkExtremeVibration(const CheckContext& c, std::vector<Hazard>& out);
 void checkHighRestitution(const CheckContext& c, std::vector<Hazard>& out);
 void checkSpawnStream(const CheckContext& c, std::size_t part, std::vector<Hazard>& out);
 void checkWeakCollider(const CheckContext& c, std::size_t part, std::vector<Hazard>& out);

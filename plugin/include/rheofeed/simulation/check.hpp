@@ -25,6 +25,8 @@ struct Hazard {
     /// thickness of the thinnest fixture geom and the thinnest part: its centre then crosses
     /// the fixture's mid-surface within one step, the collider's least-penetration normal
     /// points out of the far side and the part is pushed through (or it skips the fixture).
+    /// Checked for the reference engine and for ODE with speculative contacts off: ODE's
+    /// speculative contacts give a fast part its contacts before it arrives.
     Tunnelling,
     /// A box standing on another box (overlapping it in plan) whose bottom lies less than the
     /// thinnest part's thickness below the other's top (or above it): a thin part slips into
@@ -35,6 +37,12 @@ struct Hazard {
     MassRatio,
     /// Full vibration: fewer than kMinStepsPerCycle steps per vibration period.
     CoarseVibrationStep,
+    /// A vibrating fixture's peak acceleration is beyond kMaxFeederAcceleration times gravity:
+    /// vibratory feeders run at a few g, so a value far beyond is most often a unit slip (an
+    /// amplitude in millimetres given as metres, a torsion in degrees given as radians). value:
+    /// the peak acceleration (m/s^2): A w^2 for the translation, theta w^2 r for the torsion at
+    /// the fixture's farthest point r from the axis, combined as perpendicular; limit: the bound.
+    ExtremeVibration,
     /// A spawn region reaches into a fixture geom: parts start inside it.
     SpawnInsideFixture,
     /// A spawn region lies below Scene::removal_height: parts are removed as they appear.
@@ -78,6 +86,13 @@ const char* toString(Hazard::Kind kind);
 /// fixture's secant velocity over one step averages the sine over the step: at 20 steps per
 /// cycle its peak is 1 - sin(pi / 20) / (pi / 20) = 0.4 % low and lags by half a step, 9 degrees).
 constexpr double kMinStepsPerCycle = 20;
+
+/// Peak feeder acceleration, in units of |gravity| (9.81 m/s^2 without gravity), beyond which
+/// the check warns (ExtremeVibration): vibratory feeders run at throw numbers of about 1 to 5
+/// (NOTES section 5), a few g; the stability matrix's extreme track runs at throw number 6 (about
+/// 12 g along its 30 degree vibration). Not a measured boundary of the engines: a plausibility
+/// bound that catches a unit slip, which is 1000 times off.
+constexpr double kMaxFeederAcceleration = 50;
 
 /// Restitution from which the check warns (dimensionless): from one observation (boxes dropped
 /// 0.5 m on a belt with restitution 1 gained energy), not a measured boundary; the stability
