@@ -720,6 +720,18 @@ TEST(SceneFileErrors, UnknownBroadPhaseIsExplained) {
   EXPECT_EQ(s.solver.broad_phase, BroadPhase::Hash);
 }
 
+// A throw angle of more than a turn is never needed: "angle_rad": 20 was meant in degrees.
+TEST(SceneFileErrors, AThrowAngleBeyondOneTurnIsRefusedAsAUnitSlip) {
+  const std::string angle = R"("angle_deg": 20)";
+  refused(replaced(kGood, angle, R"("angle_rad": 20)"), "fixtures[0].law.vibration.angle_rad",
+          "a throw angle must be within one turn, [-360, 360] degrees or [-2 pi, 2 pi] rad, got "
+          "20 rad (did you mean angle_deg?)");
+  refused(replaced(kGood, angle, R"("angle_deg": 400)"), "fixtures[0].law.vibration.angle_deg",
+          "got 400 degrees");
+  const Scene s = parseScene(replaced(kGood, angle, R"("angle_rad": 0.35)"), "rad.json");
+  EXPECT_NEAR(s.fixtures[0].law.vibration.direction.z, std::sin(0.35), 1e-15);
+}
+
 TEST(SceneFileErrors, BadDriftModelAndEfficiencyAreExplained) {
   const std::string law = R"("angle_deg": 20}})";
   auto withLaw = [&](const std::string& extra) {

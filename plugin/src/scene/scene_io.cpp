@@ -299,6 +299,14 @@ void readVibration(Object& o, Vibration& v) {
   double angle = 0;
   if (o.optAngle("angle", angle)) {  // throw angle above +x, in the x-z plane
     if (o.has("direction")) fail(o.at("direction"), "give either direction or angle, not both");
+    if (std::abs(angle) > 2 * kPi) {  // more than a turn: most often degrees given as radians
+      const bool rad = o.has("angle_rad");
+      fail(o.at(rad ? "angle_rad" : "angle_deg"),
+           "a throw angle must be within one turn, [-360, 360] degrees or [-2 pi, 2 pi] rad, "
+           "got " +
+               show(rad ? angle : angle * 180 / kPi) + (rad ? " rad" : " degrees") +
+               (rad ? " (did you mean angle_deg?)" : ""));
+    }
     v.direction = {std::cos(angle), 0, std::sin(angle)};
   } else {
     o.opt("direction", v.direction, UnitVector{});
