@@ -823,6 +823,9 @@ TEST(SceneFile, LoadSceneReadsAFile) {
   const Scene s = loadScene(file);
   EXPECT_EQ(s.fixtures[0].name, "track");
   EXPECT_EQ(s.parts.size(), 3u);
+  // The scene knows its file (a run's JSON names it as scene_source); from text it has none.
+  EXPECT_EQ(s.source_file, fs::absolute(file).lexically_normal().string());
+  EXPECT_EQ(parseScene(kGood, "text.json").source_file, "");
   fs::remove(file);
 }
 

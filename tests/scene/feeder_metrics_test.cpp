@@ -323,6 +323,15 @@ TEST(FeederMetrics, FamiliesThatShareANameAreToldApartByTheirIndex) {
   EXPECT_EQ(uniqueNames({"a", "a", "a[1]"}), (std::vector<std::string>{"a", "a[1]", "a[1][2]"}));
 }
 
+// A library caller's run of a loaded scene names its file like `rheofeed run` does.
+TEST(FeederMetrics, ARunNamesTheFileItsSceneWasLoadedFrom) {
+  Scene s = dropScene({0, 0, -1});
+  s.duration = 0.1;
+  EXPECT_EQ(measureRun(s, Method::OdeRheonomic).scene_file, "");  // built in code
+  s.source_file = "/data/scenes/drop.json";
+  EXPECT_EQ(measureRun(s, Method::OdeRheonomic).scene_file, "/data/scenes/drop.json");
+}
+
 TEST(FeederMetrics, NoPartReachingTheExitIsSaid) {
   Scene s = dropScene({0, 0, -1});
   s.duration = 0.1;  // shorter than the 0.175 s fall

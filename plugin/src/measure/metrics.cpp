@@ -147,6 +147,7 @@ class RunMeter : public RunObserver {
         every_(schedule.sample_every),
         family_(partFamilies(scene)) {
     m_.scene = scene.name;
+    m_.scene_file = scene.source_file;
     m_.method = method;
     m_.time_step = h_;
     m_.seed = scene.seed;

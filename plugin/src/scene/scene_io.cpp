@@ -759,7 +759,9 @@ Scene loadScene(const fs::path& file, const MeshLoader& mesh_loader) {
                              " bytes while being read");
   }
   if (text.empty()) throw SceneFileError(file.string(), "", "the file is empty");
-  return parseScene(text, file.string(), mesh_loader);
+  Scene scene = parseScene(text, file.string(), mesh_loader);
+  scene.source_file = fs::absolute(file, ec).lexically_normal().string();
+  return scene;
 }
 
 }  // namespace rheofeed::scene

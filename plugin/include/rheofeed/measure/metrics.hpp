@@ -141,9 +141,9 @@ struct DriftField {
 /// The result of one run.
 struct RunMetrics {
   std::string scene;  ///< Scene::name
-  /// The scene file the run's scene was read from (the path as the caller resolved it: a file
-  /// given to `rheofeed run`, or a shipped scene's file); empty for a scene built in code (the
-  /// run JSON then says "built-in"). Filled by the caller of measureRun, which alone knows it.
+  /// The scene file the run's scene was read from (Scene::source_file, set by loadScene; a
+  /// caller may name another); empty for a scene built in code or parsed from text (the run
+  /// JSON then says "built-in").
   std::string scene_file;
   Method method = Method::OdeRheonomic;
   double time_step = 0;    ///< (s)

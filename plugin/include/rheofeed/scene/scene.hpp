@@ -306,6 +306,10 @@ struct Outputs {
 
 struct Scene {
   std::string name = "scene";
+  /// The file loadScene read the scene from (absolute, normalised); empty for a scene built in
+  /// code or parsed from text. Not part of the scene file (toJson does not write it): a run
+  /// reports it (RunMetrics::scene_file).
+  std::string source_file;
   Vec3 gravity{0, 0, -9.81};  ///< (m/s^2, world, |g| <= 1e3)
   std::vector<Fixture> fixtures;
   std::vector<PartSpec> parts;

@@ -55,7 +55,8 @@ using MeshLoader = std::function<TriangleMesh(const std::filesystem::path& file,
 /// and a larger one are refused before anything is read (scene files are hand-written
 /// parameters, 12 KB for the largest demo; the cap bounds the JSON DOM). Throws
 /// SceneFileError naming the file (and the JSON path of a bad value) for all of these, for a
-/// file that cannot be read, for bad values (limits: scene.hpp) and for bad meshes.
+/// file that cannot be read, for bad values (limits: scene.hpp) and for bad meshes. The scene's
+/// source_file is the file's absolute path.
 Scene loadScene(const std::filesystem::path& file, const MeshLoader& mesh_loader = {});
 
 /// As loadScene, from the text `json_text`; `source_name` names it in messages and its parent
