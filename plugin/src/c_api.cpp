@@ -299,6 +299,11 @@ int rfFeederSetGetContactsDriven(rfFeederSetID set, dGeomID geom) {
 int rfFeederSetGetStats(rfFeederSetID set, dGeomID geom, rfFeederStats* out) {
   return guarded(set, [&] {
     if (!out) throw std::invalid_argument("rfFeederSetGetStats: out is a null pointer");
+    if (out->size < sizeof(rfFeederStats)) {
+      throw std::invalid_argument("rfFeederSetGetStats: out->size = " + std::to_string(out->size) +
+                                  ": set it to sizeof(rfFeederStats), " +
+                                  std::to_string(sizeof(rfFeederStats)) + " for this library");
+    }
     const rheofeed::FeederStats& s = set->set.stats(geom);
     out->contacts_driven = s.contacts_driven;
     out->contacts_undriven = s.contacts_undriven;

@@ -468,6 +468,11 @@ static void diagnosticsAndBadCalls(struct Fixture* fx) {
   contacts[0].geom.g2 = part_geom;
   contacts[0].geom.normal[2] = 1.0;
   contacts[0].surface.mu = -1.0;
+  memset(&before, 0, sizeof before);
+  memset(&after, 0, sizeof after);
+  CHECK(rfFeederSetGetStats(set, belt, &before) == rfErrorInvalidArgument); /* size not set */
+  CHECK_MENTIONS(rfFeederSetGetLastError(set), "out->size = 0: set it to sizeof(rfFeederStats)");
+  before.size = after.size = sizeof(rfFeederStats);
   CHECK(rfFeederSetGetStats(set, belt, &before) == rfOK);
   CHECK(rfFeederSetDriveContacts(set, contacts, 1) == 0);
   CHECK(seen.count == 1);

@@ -170,6 +170,10 @@ int rfFeederSetGetContactsDriven(rfFeederSetID set, dGeomID geom);
 /** One feeder's counters (rfFeederSetGetStats). "This pass": since the last
  *  rfFeederSetBeginStep; "in all": since the feeder was added. Counts of contacts. */
 typedef struct rfFeederStats {
+  /** Set by the caller to sizeof(rfFeederStats) before the call: a later library that adds
+   *  counters at the end writes only what this size holds, so a program built against this
+   *  header keeps working. */
+  unsigned int size;
   int contacts_driven;                 /**< given fdir1/motion1 (this pass) */
   int contacts_undriven;               /**< left with no surface velocity (this pass) */
   unsigned long long invalid_contacts; /**< removed for bad data (in all) */
@@ -180,7 +184,8 @@ typedef struct rfFeederStats {
 } rfFeederStats;
 
 /** Writes `geom`'s counters into `out`: what the diagnostic function reports one by one, as
- *  totals. Returns rfOK, or a negative rfError code for an unregistered geom or a null `out`. */
+ *  totals. Returns rfOK, or a negative rfError code for an unregistered geom, a null `out` or
+ *  an `out->size` smaller than this header's rfFeederStats (the message names it). */
 int rfFeederSetGetStats(rfFeederSetID set, dGeomID geom, rfFeederStats* out);
 
 /** Friction models (rfFeederSetSetFrictionModel). */
