@@ -595,8 +595,18 @@ TEST(RunHealth, ReferenceJsonCountsFallbackStepsAsTheWorldReportsThem) {
         settings.coulomb_solver = reference::CoulombSolver::RelaxedFixedPoint;
         settings.solver.coulomb_outer_iterations = 2;
       });
+  testing::internal::CaptureStderr();
   const RunMetrics r = measureRun(*sim, s);
+  const std::string said = testing::internal::GetCapturedStderr();
   ASSERT_GT(r.health.coulomb_fallback_steps, 0) << "no step took the fallback: nothing is checked";
+  // The unconverged step's message states the mode's real budget: its iteration count sums the
+  // fixed point's rounds, each of up to solver.iterations.
+  ASSERT_GT(r.health.solver_unconverged_steps, 0);
+  EXPECT_NE(said.find("coulomb_fixed_point runs 2 rounds of at most " +
+                      std::to_string(s.solver.iterations) +
+                      " iterations each, then normal re-solves (the count sums them all)"),
+            std::string::npos)
+      << said;
   const nlohmann::json h = nlohmann::json::parse(summaryJson(r)).at("health");
   EXPECT_EQ(h.at("coulomb_fallback_steps").get<long>(), r.health.coulomb_fallback_steps);
   EXPECT_EQ(h.at("solver_unconverged_steps").get<long>(), r.health.solver_unconverged_steps);

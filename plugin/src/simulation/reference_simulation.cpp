@@ -91,6 +91,23 @@ class ReferenceSimulation final : public PartSimulation {
     a.bounce_velocity = s.bounce_velocity;
   }
 
+  // What one step's contact solve may run in the applied mode; its iteration count sums all of
+  // it (ccp/solver.cpp: the fixed point's rounds and normal re-solves; world_contacts.cpp: the
+  // interior-point rounds after NSGS).
+  std::string solveBudget() const {
+    const std::string n = std::to_string(applied_.iterations.value_or(0));
+    if (applied_.mode == "coulomb_fixed_point") {
+      return std::to_string(applied_.coulomb_iterations.value_or(0)) + " rounds of at most " + n +
+             " iterations each, then normal re-solves (the count sums them all)";
+    }
+    if (applied_.mode == "coulomb_nsgs") {
+      return "at most " + n + " sweeps, then up to " +
+             std::to_string(applied_.ipm_rounds.value_or(0)) +
+             " interior-point and NSGS rounds while unconverged (the count sums them all)";
+    }
+    return "at most " + n + " iterations";
+  }
+
   // Counts the steps whose contact solve cannot be trusted fully (RunHealth).
   void advance(double h) override {
     reference::StepReport report;
@@ -149,9 +166,8 @@ class ReferenceSimulation final : public PartSimulation {
       std::ostringstream line;
       line << "step from t = " << time() << " s: contact solve "
            << ccp::toString(report.solve.status) << " after " << report.solve.iterations
-           << " iterations (" << report.contacts << " contacts; " << applied_.mode
-           << " runs at most " << applied_.iterations.value_or(0)
-           << " iterations to solver.tolerance = " << scene_.solver.tolerance << ")";
+           << " iterations (" << report.contacts << " contacts; " << applied_.mode << " runs "
+           << solveBudget() << " to solver.tolerance = " << scene_.solver.tolerance << ")";
       reportFirst("unconverged step", line.str());
     }
   }
