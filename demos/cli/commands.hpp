@@ -43,7 +43,8 @@ int runCommand(const RunArgs& args);
 /// has no answer (runAnswer, metrics.hpp): it measured no part and saw none cross the exit
 /// (every part lost, spawned beyond the exit plane, or none spawned), or it lost more than
 /// --max-lost-fraction of the parts it spawned. stderr says why, and so does each run JSON's
-/// "answer". Sweep jobs record such a point, with its health, as done (sweep_job.cpp).
+/// "answer". Sweep jobs record such a point as done, with status "no_answer" and its health
+/// (sweep_job.cpp); it is not run again and collect leaves it out of the means.
 inline constexpr int kNoAnswerExitCode = 3;
 
 /// Says on stderr ("<program>: note: ... ignored: <why>") that --warmup-cycles / --measure-cycles
@@ -82,8 +83,9 @@ int studyCommand(const StudyArgs& args);
 
 /// `rheofeed sweep SPEC`: checks the sweep spec, writes the sweep folder and runs its unfinished
 /// jobs with a backend (local, parallel) or writes (and with `submit` submits) the Slurm scripts;
-/// then collects (sweep.hpp). Exit code 0 when every job has finished, 1 when some failed, 2 for
-/// a bad spec or command line (nothing run), 130 when interrupted.
+/// then collects (sweep.hpp). Exit code 0 when every job has finished (a job whose run has no
+/// answer has: status no_answer, listed by collect on stderr), 1 when some failed, 2 for a bad
+/// spec or command line (nothing run), 130 when interrupted.
 struct SweepArgs {
   std::string spec;
   std::string backend = "local";  ///< local, parallel or slurm

@@ -11,7 +11,8 @@
 // shipped_scenes.hpp) or a scene file. Exit codes: 0 success, 1 a failure while running (check:
 // the scene has hazards), 2 bad input (command line or scene; nothing has run), 3 (run) a run
 // gave no answer: it measured no part and none crossed the exit, or it lost more than
-// --max-lost-fraction of its parts (kNoAnswerExitCode).
+// --max-lost-fraction of its parts (kNoAnswerExitCode; a sweep records such a job as
+// "no_answer").
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
