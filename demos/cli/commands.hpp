@@ -3,7 +3,7 @@
 // code: 0 success, 2 bad input (a message on stderr naming the value, where it came from and the
 // allowed range; nothing has run), 1 a failure while running (e.g. an output that cannot be
 // written); `check` returns 1 when the scene has hazards; `run` returns kNoAnswerExitCode when a
-// run gave no answer.
+// run gave no answer (runAnswer: no part measured, or more than --max-lost-fraction lost).
 #pragma once
 
 #include <functional>
@@ -12,6 +12,7 @@
 
 #include "cli/run_plan.hpp"
 #include "rheofeed/measure/calibration.hpp"
+#include "rheofeed/measure/metrics.hpp"
 
 namespace rheofeed::cli {
 
@@ -33,12 +34,17 @@ struct RunArgs {
   bool drift_table_given = false;
   /// --warmup-cycles or --measure-cycles given (noteIgnoredCycleOptions).
   bool cycles_given = false;
+  /// --max-lost-fraction: a run that loses more than this share of the parts it spawned has no
+  /// answer (RunMetrics::max_lost_fraction, runAnswer); in [0, 1] (main.cpp checks it).
+  double max_lost_fraction = rheofeed::scene::kDefaultMaxLostFraction;
 };
 int runCommand(const RunArgs& args);
 /// `rheofeed run`'s exit code when every run finished and its outputs are written but a run
-/// measured no part and saw none cross the exit (every part lost, spawned beyond the exit plane,
-/// or none spawned): a run with no answer. Sweep jobs record such a point, with its health, as
-/// done (sweep_job.cpp).
+/// has no answer (runAnswer, metrics.hpp): it measured no part and saw none cross the exit
+/// (every part lost, spawned beyond the exit plane, or none spawned), or it lost more than
+/// --max-lost-fraction of the parts it spawned. stderr says why, and so does each run JSON's
+/// "answer". Sweep jobs record such a point as done, with status "no_answer" and its health
+/// (sweep_job.cpp); it is not run again and collect leaves it out of the means.
 inline constexpr int kNoAnswerExitCode = 3;
 
 /// Says on stderr ("<program>: note: ... ignored: <why>") that --warmup-cycles / --measure-cycles
@@ -77,8 +83,9 @@ int studyCommand(const StudyArgs& args);
 
 /// `rheofeed sweep SPEC`: checks the sweep spec, writes the sweep folder and runs its unfinished
 /// jobs with a backend (local, parallel) or writes (and with `submit` submits) the Slurm scripts;
-/// then collects (sweep.hpp). Exit code 0 when every job has finished, 1 when some failed, 2 for
-/// a bad spec or command line (nothing run), 130 when interrupted.
+/// then collects (sweep.hpp). Exit code 0 when every job has finished (a job whose run has no
+/// answer has: status no_answer, listed by collect on stderr), 1 when some failed, 2 for a bad
+/// spec or command line (nothing run), 130 when interrupted.
 struct SweepArgs {
   std::string spec;
   std::string backend = "local";  ///< local, parallel or slurm

@@ -10,7 +10,9 @@
 // SCENE is the name of a shipped scene (demos/scenes, installed in share/rheofeed/scenes; see
 // shipped_scenes.hpp) or a scene file. Exit codes: 0 success, 1 a failure while running (check:
 // the scene has hazards), 2 bad input (command line or scene; nothing has run), 3 (run) a run
-// gave no answer: it measured no part and none crossed the exit (kNoAnswerExitCode).
+// gave no answer: it measured no part and none crossed the exit, or it lost more than
+// --max-lost-fraction of its parts (kNoAnswerExitCode; a sweep records such a job as
+// "no_answer").
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -99,6 +101,26 @@ CLI::Validator cyclesCheck(const char* option, bool positive) {
       "", option);
 }
 
+// CLI11 check of --max-lost-fraction: a number in [0, 1] (nan refused).
+CLI::Validator fractionCheck() {
+  return CLI::Validator(
+      [](std::string& text) {
+        double v = 0;
+        try {
+          std::size_t used = 0;
+          v = std::stod(text, &used);
+          if (used != text.size()) v = std::nan("");
+        } catch (const std::exception&) {
+          v = std::nan("");
+        }
+        if (v >= 0 && v <= 1) return std::string();
+        return "got " + text +
+               ": must be a number in [0, 1] (the share of the parts it spawned a run may lose "
+               "and still have an answer)";
+      },
+      "", "--max-lost-fraction");
+}
+
 void addCalibrateOptions(CLI::App* sub, CalibrateOptions& c) {
   sub->add_flag("--classical", c.classical,
                 "calibrate with the classical single-part model (milliseconds, a straight-track "
@@ -126,7 +148,8 @@ int main(int argc, char** argv) {
   app.footer(
       "Exit codes: 0 success; 1 a failure while running (check: hazards found); 2 bad input "
       "(command line or scene), nothing has run; 3 (run) a run gave no answer: it measured no "
-      "part and none crossed the exit (every part lost, say), its outputs written.\nShipped "
+      "part and none crossed the exit (every part lost, say), or it lost more than "
+      "--max-lost-fraction of its parts; its outputs written.\nShipped "
       "scenes (" +
       (dataDir() / "scenes").string() + "): " + shippedList());
 
@@ -151,6 +174,14 @@ int main(int argc, char** argv) {
           "FILE exists, written back after them with what they added, so that later runs of the "
           "scene skip those model runs (same drifts, bit for bit)")
       ->each([&run](const std::string&) { run.drift_table_given = true; });
+  run_cmd
+      ->add_option("--max-lost-fraction", run.max_lost_fraction,
+                   "a run that loses more than this share of the parts it spawned (through a "
+                   "fixture, off the feeder, blown up...) has no answer: its outputs are written, "
+                   "stderr and the JSON's \"answer\" say why, and the exit code is 3. In [0, 1]; "
+                   "1 accepts any loss")
+      ->check(fractionCheck())
+      ->default_val(run.max_lost_fraction);
   addCalibrateOptions(run_cmd, run.calibrate);
 
   CalibrateArgs cal;

@@ -70,17 +70,18 @@ Progress lineProgress(const std::string& label, double simulated_seconds) {
   };
 }
 
-// One gnuplot figure with a line per run, from the series CSV blocks (column `column`).
+// One gnuplot figure with a line per run, from the series CSV blocks (column `column`), each
+// titled by its label (`labels`, one per block).
 void plotRuns(const std::vector<std::pair<std::string, std::string>>& blocks,
-              const std::string& title, const std::string& ylabel, const std::string& using_expr,
-              const std::string& path) {
+              const std::vector<std::string>& labels, const std::string& title,
+              const std::string& ylabel, const std::string& using_expr, const std::string& path) {
   std::string gp =
       "set datafile separator ','\nset grid\nset key bottom right\n"
       "set xlabel 'time (s)'\nset ylabel '" +
       ylabel + "'\nset title '" + title + "'\nplot ";
   for (std::size_t k = 0; k < blocks.size(); ++k) {
     gp += (k ? ", " : "") + std::string("$") + blocks[k].first + " using " + using_expr +
-          " with lines lw 2 title '" + blocks[k].first + "'";
+          " with lines lw 2 title '" + labels[k] + "'";
   }
   plotPng(gp, blocks, path);
 }
@@ -239,7 +240,7 @@ int runCommand(const RunArgs& args) {
     return 2;
   }
 
-  std::vector<std::string> no_answer;  // runs with no part measured (kNoAnswerExitCode)
+  std::vector<std::string> no_answer;  // runs with no answer (runAnswer; kNoAnswerExitCode)
   const int code = runChecked("rheofeed run", [&] {
     // A rheonomic run of a vibrating feeder needs its drift field: calibrated once, here, when
     // the scene does not give it (`rheofeed calibrate` saves it into the scene).
@@ -283,10 +284,11 @@ int runCommand(const RunArgs& args) {
     std::printf(
         "| method | h (s) | parts | mean drift (%s) | 95 %% CI | vertical disp. (m) | "
         "throughput (parts/s) | CPU (s) | real-time factor | lost parts | Coulomb fallback "
-        "steps |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "steps | answer |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         unit.c_str());
     std::fflush(stdout);
     std::vector<std::pair<std::string, std::string>> blocks;
+    std::vector<std::string> labels;  // the method, and whether its run has no answer
     for (std::size_t k = 0; k < plan.runs.size(); ++k) {
       const PlannedRun& run = plan.runs[k];
       const Method m = run.method;
@@ -306,10 +308,12 @@ int runCommand(const RunArgs& args) {
       r.scene_check = hazards;
       if (!isFullVibration(m)) r.calibration_warnings = calibration_warnings;
       r.scene_file = std::filesystem::absolute(plan.file).lexically_normal().string();
+      r.max_lost_fraction = args.max_lost_fraction;
       writeRunOutputs(r, out.string(), toString(m));
       if (recorder) recorder->write(out / (toString(m) + std::string(".glb")));
       blocks.emplace_back(toString(m), seriesCsv(r));
       const RunHealth& h = r.health;
+      const RunAnswer answer = runAnswer(r, "--max-lost-fraction");
       char ci[32] = "n/a";  // no confidence interval over fewer than two parts
       if (ci95Defined(r.drift_parts)) std::snprintf(ci, sizeof ci, "%.5f", r.mean_drift_ci95);
       char drift[32] = "n/a", height[32] = "n/a";  // no part measured
@@ -317,27 +321,22 @@ int runCommand(const RunArgs& args) {
       if (r.displacement_parts > 0) {
         std::snprintf(height, sizeof height, "%.4f", r.vertical_displacement);
       }
-      std::printf("| %s | %.3g | %d | %s | %s | %s | %.2f | %.2f | %.4f | %d | %.1f %% |\n",
+      std::printf("| %s | %.3g | %d | %s | %s | %s | %.2f | %.2f | %.4f | %d | %.1f %% | %s |\n",
                   toString(m), r.time_step, r.parts, drift, ci, height, r.throughput, r.cpu_seconds,
                   r.real_time_factor, h.partsLost(),
-                  100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps));
+                  100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps),
+                  answer.trusted ? "yes" : "no (see stderr)");
       std::fflush(stdout);
-      if (r.drift_parts == 0 && r.feeder.exit_times.empty()) {
-        const std::string why = r.parts == 0 ? "spawned no part"
-                                : h.partsLost() >= r.parts
-                                    ? "lost all " + std::to_string(r.parts) + " parts it spawned"
-                                    : "measured none of its " + std::to_string(r.parts) +
-                                          " parts (" + std::to_string(h.partsLost()) + " lost, " +
-                                          std::to_string(r.feeder.spawned_beyond_exit) +
-                                          " spawned beyond the exit plane)";
+      labels.push_back(toString(m) + std::string(answer.trusted ? "" : " (no answer)"));
+      for (const std::string& why : answer.why) {
         no_answer.push_back(std::string(toString(m)) + " " + why);
       }
     }
     if (blocks.size() > 1) {
-      plotRuns(blocks, plan.scene.name + ": methods compared", "mean drift (" + unit + ")", "1:3",
-               (out / "methods.png").string());
+      plotRuns(blocks, labels, plan.scene.name + ": methods compared", "mean drift (" + unit + ")",
+               "1:3", (out / "methods.png").string());
     }
-    plotRuns(blocks, plan.scene.name + ": mean height of the parts",
+    plotRuns(blocks, labels, plan.scene.name + ": mean height of the parts",
              "mean height of the parts (mm)", "1:(1000 * $5)", (out / "mean_height.png").string());
     std::printf("\noutputs in %s/\n", out.string().c_str());
     if (args.animation) {  // the page shows every plot of the folder
@@ -352,11 +351,12 @@ int runCommand(const RunArgs& args) {
                   page.string().c_str());
     }
     if (table) table->save();  // last: a table that cannot be written costs no other output
-    // Written and said, but a run that measured no part and saw none leave has no answer.
+    // Written and said, but a run that measured no part and saw none leave, or lost more than
+    // --max-lost-fraction of its parts, has no answer (runAnswer).
     for (const std::string& a : no_answer) {
       std::fprintf(stderr,
-                   "rheofeed run: no answer: %s (its outputs are written; stderr and the JSON's "
-                   "health say why); exit code %d\n",
+                   "rheofeed run: no answer: %s (its outputs are written; the JSON's answer "
+                   "and health say why); exit code %d\n",
                    a.c_str(), kNoAnswerExitCode);
     }
   });

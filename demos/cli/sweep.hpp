@@ -14,9 +14,11 @@
 //                 depends on it);
 //   runJob        one job: an ordinary `rheofeed run` of the job's scene file, then its record
 //                 (parameters, metrics, health, status, CPU time, version, scene hash) written
-//                 atomically; a job with a record of status "ok" is never run again;
+//                 atomically; a finished job (status "ok", or "no_answer": the run gave no
+//                 answer, kNoAnswerExitCode, and would give none again) is never run again;
 //   collect       one CSV of the parameters and the metrics' means and 95 % intervals over the
-//                 seeds, plots, and the failed or missing jobs with the command that reruns them.
+//                 seeds with an answer, the seeds with none counted apart, plots, and the
+//                 failed or missing jobs with the command that reruns them.
 //
 // The sweep folder (DIR):
 //   sweep.json                 manifest: the spec, the base scene, the job list with hashes
@@ -139,8 +141,12 @@ Manifest readManifest(const Folder& folder);
 /// The record of a job, as far as collect needs it.
 struct Record {
   std::string id;
-  std::string status;  ///< "ok" or "failed"
-  std::string error;   ///< failed: why (the run's last message, or the signal)
+  /// "ok"; "no_answer": the run finished without an answer (`rheofeed run` exited with
+  /// kNoAnswerExitCode: parts lost beyond its bound, none measured), its metrics and health
+  /// recorded but left out of the means; or "failed".
+  std::string status;
+  std::string error;      ///< failed: why (the run's last message, or the signal)
+  std::string no_answer;  ///< no_answer: why, per method ("ode_rheonomic lost 3 of 4 parts ...")
   int point = 0;
   std::uint64_t seed = 0;
   /// metrics[method][metric]: the value, or nullopt when the run's JSON has null (e.g. no exit).
@@ -159,7 +165,11 @@ const std::vector<std::string>& healthKeys();
 std::optional<Record> readRecord(const Folder& folder, const Manifest& manifest,
                                  const std::string& id);
 
-/// The ids of the jobs without a record of status "ok", in job order.
+/// A job of this record has finished: its status is "ok" or "no_answer" (a deterministic run
+/// with no answer gives none again). Every other status is run again.
+bool finished(const Record& record);
+
+/// The ids of the jobs without a finished record (finished), in job order.
 std::vector<std::string> unfinishedJobs(const Folder& folder, const Manifest& manifest);
 
 /// The `sweep job` process running job `id`: it holds the job's lock, jobs/<id>/job.lock (an
@@ -187,8 +197,9 @@ constexpr const char* kStopFileVariable = "RHEOFEED_SWEEP_STOP_FILE";
 /// The command that runs (or reruns) job `id` by hand.
 std::string jobCommand(const Folder& folder, const std::string& id);
 
-/// Runs job `id` unless it has an "ok" record: `rheofeed run` of its scene file into
-/// jobs/<id>/run, then writes its record. Returns 0 for a finished job (now or before), 1 for a
+/// Runs job `id` unless it has a finished record: `rheofeed run` of its scene file into
+/// jobs/<id>/run, then writes its record (status "ok", "no_answer" with why, or "failed").
+/// Returns 0 for a finished job (now or before, with or without an answer), 1 for a
 /// failed one (its record says why) or one another process is running (no record; the line
 /// names that process), 130/143 when interrupted by SIGINT/SIGTERM (no record; the run is
 /// stopped too) or started by a backend that has since been interrupted (kStopFileVariable). Holds
@@ -216,10 +227,12 @@ std::filesystem::path writeSlurm(const Folder& folder, const Manifest& manifest,
 int runTask(const Folder& folder, const Manifest& manifest, const std::filesystem::path& tasks,
             int task);
 
-/// collect: writes results/sweep.csv (one row per point and method: the parameters, then for
-/// each metric its mean over the seeds, the 95 % interval half-width and the count, then the
-/// summed health counts), results/jobs.csv (one row per job) and the plots. Prints the failed
-/// and missing jobs with the commands that rerun them. Returns their number.
+/// collect: writes results/sweep.csv (one row per point and method: the parameters, the seeds
+/// ok, failed, missing and with no answer, then for each metric its mean over the ok seeds, the
+/// 95 % interval half-width and the count, then the health counts summed over the seeds that
+/// ran: ok and no answer), results/jobs.csv (one row per job) and the plots. Lists the jobs with
+/// no answer, with why, on stderr (they are finished: not counted). Prints the failed and
+/// missing jobs with the commands that rerun them. Returns their number.
 int collect(const Folder& folder, const Manifest& manifest);
 
 /// Number of processors this process may run on (sched_getaffinity; at least 1).

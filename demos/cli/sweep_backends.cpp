@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The engines that run a sweep's jobs (sweep.hpp): a local process pool, GNU parallel and Slurm.
 // Each runs the same job command, `rheofeed sweep job DIR ID`, so every backend writes the same
-// records; none decides by itself which jobs are done (a job with an "ok" record returns at
-// once).
+// records; none decides by itself which jobs are done (a job with a finished record, "ok" or
+// "no_answer", returns at once).
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>

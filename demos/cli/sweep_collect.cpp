@@ -53,9 +53,9 @@ Stats stats(const std::vector<double>& v) {
 struct Row {
   int point = 0;
   std::vector<double> values;  // parameters
-  int ok = 0, failed = 0, missing = 0;
+  int ok = 0, failed = 0, missing = 0, no_answer = 0;
   std::vector<Stats> metrics;
-  std::vector<double> health;  // summed over the finished seeds
+  std::vector<double> health;  // summed over the seeds that ran (ok and no answer)
 };
 
 bool uniform(const std::vector<double>& sorted) {
@@ -174,9 +174,11 @@ int collect(const Folder& folder, const Manifest& manifest) {
 
   // Records, per point.
   std::map<int, std::vector<double>> point_values;
-  std::map<int, std::vector<Record>> finished;
+  std::map<int, std::vector<Record>> answered;    // status ok: the seeds of the means
+  std::map<int, std::vector<Record>> no_answer;   // finished with no answer: counted apart
   std::map<int, std::pair<int, int>> unfinished;  // point -> (failed, missing)
   std::vector<std::string> problems;
+  std::vector<std::string> unanswered;  // the no-answer jobs, with why
   std::string jobs_csv = "id,point,seed";
   for (const Parameter& p : manifest.parameters) jobs_csv += "," + p.name;
   jobs_csv += ",method,status,cpu_s";
@@ -196,8 +198,15 @@ int collect(const Folder& folder, const Manifest& manifest) {
     auto& [n_failed, n_missing] = unfinished[job.point];
     std::string status;
     if (r && r->status == "ok") {
-      finished[job.point].push_back(*r);
+      answered[job.point].push_back(*r);
       status = "ok";
+    } else if (r && r->status == "no_answer") {
+      no_answer[job.point].push_back(*r);
+      status = "no_answer";
+      unanswered.push_back(
+          "job " + id + " (point " + std::to_string(job.point) + ", seed " +
+          std::to_string(job.seed) +
+          "): " + (r->no_answer.empty() ? std::string("no reason recorded") : r->no_answer));
     } else if (r) {
       ++n_failed;
       status = "failed";
@@ -220,9 +229,9 @@ int collect(const Folder& folder, const Manifest& manifest) {
         jobs_csv += "," + (r && r->metrics[mt][k] ? num(*r->metrics[mt][k]) : std::string());
       }
       for (std::size_t k = 0; k < health; ++k) {
-        jobs_csv += "," + (r && r->status == "ok" ? num(r->health[mt][k]) : std::string());
+        jobs_csv += "," + (r && finished(*r) ? num(r->health[mt][k]) : std::string());
       }
-      std::string e = r ? r->error : error;
+      std::string e = !r ? error : r->status == "no_answer" ? r->no_answer : r->error;
       std::replace(e.begin(), e.end(), '"', '\'');
       jobs_csv += ",\"" + e + "\"\n";
     }
@@ -231,7 +240,7 @@ int collect(const Folder& folder, const Manifest& manifest) {
   // sweep.csv: one row per point and method.
   std::string csv = "point";
   for (const Parameter& p : manifest.parameters) csv += "," + p.name;
-  csv += ",method,seeds_ok,seeds_failed,seeds_missing";
+  csv += ",method,seeds_ok,seeds_failed,seeds_missing,seeds_no_answer";
   for (const Metric& m : manifest.metrics)
     csv += "," + m.name + "_mean," + m.name + "_ci95," + m.name + "_n";
   for (const std::string& h : healthKeys()) csv += "," + h;
@@ -242,28 +251,34 @@ int collect(const Folder& folder, const Manifest& manifest) {
       Row row;
       row.point = point;
       row.values = values;
-      row.ok = static_cast<int>(finished[point].size());
+      row.ok = static_cast<int>(answered[point].size());
       row.failed = unfinished[point].first;
       row.missing = unfinished[point].second;
+      row.no_answer = static_cast<int>(no_answer[point].size());
       row.health.assign(health, 0.0);
       for (std::size_t k = 0; k < metrics; ++k) {
         std::vector<double> v;
-        for (const Record& r : finished[point]) {
+        for (const Record& r : answered[point]) {
           if (r.metrics[mt][k] && std::isfinite(*r.metrics[mt][k])) v.push_back(*r.metrics[mt][k]);
         }
         row.metrics.push_back(stats(v));
       }
-      for (const Record& r : finished[point]) {
-        for (std::size_t k = 0; k < health; ++k) row.health[k] += r.health[mt][k];
+      for (const auto* records : {&answered[point], &no_answer[point]}) {
+        for (const Record& r : *records) {
+          for (std::size_t k = 0; k < health; ++k) row.health[k] += r.health[mt][k];
+        }
       }
       csv += std::to_string(point);
       for (double v : values) csv += "," + num(v);
       csv += "," + manifest.methods[mt] + "," + std::to_string(row.ok) + "," +
-             std::to_string(row.failed) + "," + std::to_string(row.missing);
+             std::to_string(row.failed) + "," + std::to_string(row.missing) + "," +
+             std::to_string(row.no_answer);
       for (const Stats& s : row.metrics) {
         csv += "," + num(s.mean) + "," + num(s.ci95) + "," + std::to_string(s.n);
       }
-      for (double h : row.health) csv += "," + (row.ok > 0 ? num(h) : std::string());
+      for (double h : row.health) {
+        csv += "," + (row.ok + row.no_answer > 0 ? num(h) : std::string());
+      }
       csv += "\n";
       rows[mt].push_back(row);
     }
@@ -302,15 +317,31 @@ int collect(const Folder& folder, const Manifest& manifest) {
     }
   }
 
-  // Failed and missing jobs, on stdout and in results/unfinished.txt.
+  // Failed and missing jobs, on stdout and in results/unfinished.txt; jobs with no answer on
+  // stderr.
   const fs::path unfinished_file = out / "unfinished.txt";
   std::error_code ec;
   const int finished_count = total - static_cast<int>(problems.size());
   std::printf(
-      "collect: %d of %d jobs finished; %s/sweep.csv (%zu points x %zu methods), "
+      "collect: %d of %d jobs finished%s; %s/sweep.csv (%zu points x %zu methods), "
       "jobs.csv and %d plots\n",
-      finished_count, total, fs::absolute(out).lexically_normal().string().c_str(),
-      point_values.size(), methods, plots);
+      finished_count, total,
+      unanswered.empty()
+          ? ""
+          : (", " + std::to_string(unanswered.size()) + " of them with no answer").c_str(),
+      fs::absolute(out).lexically_normal().string().c_str(), point_values.size(), methods, plots);
+  // Jobs with no answer: finished (a rerun gives none again), so not in unfinished.txt, but
+  // never silent: on stderr with why, status no_answer in jobs.csv, seeds_no_answer in
+  // sweep.csv, and left out of its means.
+  if (!unanswered.empty()) {
+    std::fflush(stdout);
+    std::fprintf(stderr,
+                 "collect: %zu of %d jobs have no answer (status no_answer in jobs.csv, counted "
+                 "in sweep.csv's seeds_no_answer, left out of its means and plots):\n",
+                 unanswered.size(), total);
+    for (const std::string& u : unanswered) std::fprintf(stderr, "  %s\n", u.c_str());
+    std::fflush(stderr);
+  }
   if (problems.empty()) {
     fs::remove(unfinished_file, ec);
   } else {

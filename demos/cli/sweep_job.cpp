@@ -398,6 +398,11 @@ std::optional<Record> readRecord(const Folder& folder, const Manifest& manifest,
     r.id = id;
     r.status = j.at("status").get<std::string>();
     r.error = j.at("error").is_string() ? j["error"].get<std::string>() : "";
+    if (j.contains("no_answer") && j["no_answer"].is_string()) {
+      r.no_answer = j["no_answer"].get<std::string>();
+      // A record of an earlier version: status "ok" beside its no_answer.
+      if (r.status == "ok" && !r.no_answer.empty()) r.status = "no_answer";
+    }
     r.point = j.at("point").get<int>();
     r.seed = j.at("seed").get<std::uint64_t>();
     r.cpu_seconds = j.at("cpu_seconds").get<double>();
@@ -425,6 +430,10 @@ std::optional<Record> readRecord(const Folder& folder, const Manifest& manifest,
   }
 }
 
+bool finished(const Record& record) {
+  return record.status == "ok" || record.status == "no_answer";
+}
+
 std::vector<std::string> unfinishedJobs(const Folder& folder, const Manifest& manifest) {
   std::vector<std::string> ids;
   const int count = static_cast<int>(manifest.jobs.size());
@@ -436,7 +445,7 @@ std::vector<std::string> unfinishedJobs(const Folder& folder, const Manifest& ma
     } catch (const std::exception&) {
       r.reset();
     }
-    if (!r || r->status != "ok") ids.push_back(id);
+    if (!r || !finished(*r)) ids.push_back(id);
   }
   return ids;
 }
@@ -546,9 +555,9 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
   } catch (const std::exception& e) {  // only a hand-edited record: records are written whole
     std::fprintf(stderr, "rheofeed sweep job: %s; running the job again\n", e.what());
   }
-  if (done && done->status == "ok") {
-    std::printf("job %s: finished before (record %s), not run again\n", id.c_str(),
-                folder.record(id).string().c_str());
+  if (done && finished(*done)) {
+    std::printf("job %s: finished before (record %s, %s), not run again\n", id.c_str(),
+                folder.record(id).string().c_str(), done->status.c_str());
     std::fflush(stdout);
     return 0;
   }
@@ -577,6 +586,7 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
                  {"parameters", parametersJson(manifest, job->values)},
                  {"status", "failed"},
                  {"error", nullptr},
+                 {"no_answer", nullptr},
                  {"exit_code", nullptr},
                  {"methods", manifest.methods},
                  {"metrics", Json::object()},
@@ -602,6 +612,7 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
   struct rusage usage {};
   int status = 0;
   std::string error;
+  bool no_answer = false;  // the run exited with kNoAnswerExitCode
   if (scene_text.empty() && !fs::exists(scene_file, ec)) {
     error = "the job's scene file " + scene_file.string() +
             " is missing (rerun `rheofeed sweep SPEC --out DIR`)";
@@ -642,8 +653,9 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
         error = "rheofeed run killed by signal " + std::to_string(WTERMSIG(status)) + " (" +
                 strsignal(WTERMSIG(status)) + ")";
       } else if (WEXITSTATUS(status) == kNoAnswerExitCode) {
-        // every part lost, say: a valid point of the sweep, read with its health
-        record["no_answer"] = lastMessage(log);
+        // parts lost beyond the bound, none measured: a finished point of the sweep (the run
+        // is deterministic), read with its health and recorded apart from the answers
+        no_answer = true;
       } else if (WEXITSTATUS(status) != 0) {
         error = "rheofeed run exited with code " + std::to_string(WEXITSTATUS(status)) + ": " +
                 lastMessage(log) + " (log: " + log.string() + ")";
@@ -656,6 +668,7 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
   record["wall_seconds"] = wall;
 
   // Metrics and health from each method's run JSON.
+  std::string no_answer_why;
   if (error.empty()) {
     for (const std::string& method : manifest.methods) {
       const fs::path json_file = run_dir / (method + ".json");
@@ -688,9 +701,22 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
       }
       record["metrics"][method] = values;
       record["health"][method] = run.contains("health") ? run["health"] : Json();
+      // Why a run has no answer, from its own verdict (runAnswer).
+      const Json* why =
+          run.contains("answer") && run["answer"].contains("why") ? &run["answer"]["why"] : nullptr;
+      if (no_answer && why && why->is_array()) {
+        for (const Json& w : *why) {
+          if (!w.is_string()) continue;
+          no_answer_why +=
+              (no_answer_why.empty() ? "" : "; ") + method + " " + w.get<std::string>();
+        }
+      }
     }
   }
-  record["status"] = error.empty() ? "ok" : "failed";
+  if (error.empty() && no_answer) {
+    record["no_answer"] = no_answer_why.empty() ? lastMessage(log) : no_answer_why;
+  }
+  record["status"] = !error.empty() ? "failed" : no_answer ? "no_answer" : "ok";
   if (!error.empty()) record["error"] = error;
   record["finished_utc"] = nowUtc();
   scene::writeFileAtomically(folder.record(id), record.dump(2) + "\n");
@@ -706,6 +732,7 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
                 record["cpu_seconds"].get<double>());
   line += b;
   if (!error.empty()) line += ": " + error + "; rerun: " + jobCommand(folder, id);
+  if (error.empty() && no_answer) line += ": " + record["no_answer"].get<std::string>();
   std::printf("%s\n", line.c_str());
   std::fflush(stdout);
   return error.empty() ? 0 : 1;

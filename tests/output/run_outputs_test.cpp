@@ -185,6 +185,30 @@ TEST(SeriesCsv, ASampleWithNoPartHasNoDriftAndNoHeight) {
   EXPECT_NE(rows[2][2], "");   // the next sample has its parts
 }
 
+// The verdict on the run's numbers is in the JSON, before them: 3 of the 12 parts lost (fell 2,
+// through a fixture 1) is a quarter, more than the default bound of a tenth; a bound of a
+// quarter accepts it.
+TEST(SummaryJson, SaysWhetherTheRunHasAnAnswer) {
+  RunMetrics r = run();
+  const std::string text = summaryJson(r);
+  const json lossy = json::parse(text)["answer"];
+  EXPECT_EQ(lossy["trusted"], false);
+  EXPECT_EQ(lossy["why"], json({"lost 3 of 12 parts (25 %), more than max_lost_fraction 0.1"}));
+  EXPECT_EQ(lossy["parts_lost"], 3);
+  EXPECT_EQ(lossy["lost_fraction"].get<double>(), 0.25);
+  EXPECT_EQ(lossy["max_lost_fraction"].get<double>(), 0.1);
+  EXPECT_LT(text.find("\"answer\""), text.find("\"mean_drift\""));  // read before the numbers
+
+  r.max_lost_fraction = 0.25;
+  const json within = json::parse(summaryJson(r))["answer"];
+  EXPECT_EQ(within["trusted"], true);
+  EXPECT_EQ(within["why"], json::array());
+  EXPECT_EQ(within["max_lost_fraction"].get<double>(), 0.25);
+
+  r.parts = 0;  // no share of nothing
+  EXPECT_TRUE(json::parse(summaryJson(r))["answer"]["lost_fraction"].is_null());
+}
+
 TEST(SummaryJson, ParsesToTheRunMetricsWritten) {
   const RunMetrics r = run();
   const std::string text = summaryJson(r);

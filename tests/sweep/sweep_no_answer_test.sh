@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# A point whose run loses every part (`rheofeed run` exits 3, kNoAnswerExitCode) is a valid
-# answer of the sweep: its job is ok, its record says "no_answer" and carries the run's health,
-# and sweep.csv has the point with its seed ok and a null mean drift. The scene: two boxes
-# spawned past the end of a belt, with nothing under them (tests/data/scenes/all_parts_fall.json).
+# A point whose run has no answer (`rheofeed run` exits 3, kNoAnswerExitCode: here it loses a
+# quarter of its parts, more than the default --max-lost-fraction 0.1) is a finished job with
+# status "no_answer": its record says why and carries the run's metrics and health, the next
+# sweep does not run it again, and collect counts it in sweep.csv's seeds_no_answer, leaves it
+# out of the means (its run measured a mean drift over the parts left), marks it in jobs.csv
+# and lists it on stderr with why. The scene (tests/data/scenes/some_parts_fall.json): three
+# boxes on a belt and one past its end that falls; at point 0 the removal height is too low for
+# the fall to reach in the run (nothing lost: an answer), at point 1 it is the scene's.
 #   bash sweep_no_answer_test.sh RHEOFEED SCENE WORK_DIR
 set -euo pipefail
 bin=$1 scene=$2 work=$3
@@ -13,19 +17,38 @@ cat > "$work/spec.json" <<SPEC
 {
   "name": "no_answer",
   "scene": "$scene",
-  "parameters": [{"name": "speed_mps", "pointer": "/fixtures/0/law/belt/speed", "values": [0.3]}],
+  "parameters": [{"name": "removal_height_m", "pointer": "/removal_height", "values": [-2, -0.5]}],
   "seeds": 1,
   "metrics": [{"name": "mean_drift_mps", "pointer": "/mean_drift"},
-              {"name": "lost", "pointer": "/health/parts_lost"}]
+              {"name": "trusted", "pointer": "/answer/trusted"}]
 }
 SPEC
-"$bin" sweep "$work/spec.json" --out "$work/sweep" > "$work/sweep.log" 2>&1 ||
-  fail "the sweep exited with $?, expected 0 (a run with no answer is a done job)"
-record="$work/sweep/records/0000.json"
-grep -q '"status": "ok"' "$record" || fail "job 0000 is not ok"
-grep -q '"exit_code": 3' "$record" || fail "job 0000 does not record exit code 3"
-grep -q '"no_answer": ".*lost all 2 parts' "$record" || fail "job 0000 does not say why it has no answer"
-grep -q '"parts_lost": 2' "$record" || fail "job 0000's health is not recorded"
-grep -q '^0,0.3,ode_rheonomic,1,0,' "$work/sweep/results/sweep.csv" ||
-  fail "point 0 is not 1 seed ok, 0 failed in sweep.csv: $(cat "$work/sweep/results/sweep.csv")"
-echo "a run with no answer is a done job of the sweep, with its health"
+"$bin" sweep "$work/spec.json" --out "$work/sweep" > "$work/sweep.log" 2> "$work/sweep_stderr.log" ||
+  fail "the sweep exited with $?, expected 0 (a run with no answer is a finished job)"
+ok="$work/sweep/records/0000.json" record="$work/sweep/records/0001.json"
+grep -q '"status": "ok"' "$ok" || fail "job 0000 (nothing lost) is not ok"
+grep -q '"status": "no_answer"' "$record" || fail "job 0001 is not no_answer"
+grep -q '"exit_code": 3' "$record" || fail "job 0001 does not record exit code 3"
+grep -q '"no_answer": "ode_rheonomic lost 1 of 4 parts (25 %), more than max_lost_fraction 0.1"' "$record" ||
+  fail "job 0001 does not say why it has no answer"
+grep -q '"parts_lost": 1' "$record" || fail "job 0001's health is not recorded"
+grep -q '"mean_drift_mps": [0-9]' "$record" || fail "job 0001's run measured no mean drift (the test needs one to leave out)"
+grep -q '"trusted": 0' "$record" || fail "job 0001's metric /answer/trusted is not 0"
+csv="$work/sweep/results/sweep.csv"
+head -1 "$csv" | grep -q '^point,removal_height_m,method,seeds_ok,seeds_failed,seeds_missing,seeds_no_answer,mean_drift_mps_mean,' ||
+  fail "sweep.csv has no seeds_no_answer column: $(head -1 "$csv")"
+grep -q '^0,-2,ode_rheonomic,1,0,0,0,[0-9]' "$csv" || fail "point 0 is not 1 seed ok with a mean: $(cat "$csv")"
+# point 1: no seed ok, 1 with no answer, no mean (the no-answer seed is left out), n 0
+grep -q '^1,-0.5,ode_rheonomic,0,0,0,1,,,0,' "$csv" ||
+  fail "point 1 is not 1 seed with no answer and no mean in sweep.csv: $(cat "$csv")"
+grep -q '^0001,1,1,-0.5,ode_rheonomic,no_answer,.*"ode_rheonomic lost 1 of 4 parts' "$work/sweep/results/jobs.csv" ||
+  fail "jobs.csv does not mark job 0001 no_answer with why: $(cat "$work/sweep/results/jobs.csv")"
+grep -q '1 of 2 jobs have no answer' "$work/sweep_stderr.log" || fail "collect does not say on stderr that a job has no answer"
+grep -q 'job 0001 (point 1, seed 1): ode_rheonomic lost 1 of 4 parts' "$work/sweep_stderr.log" ||
+  fail "collect does not list job 0001 with why on stderr"
+[ ! -e "$work/sweep/results/unfinished.txt" ] || fail "a job with no answer is listed as unfinished"
+# The sweep again runs nothing: a run with no answer would give none again.
+"$bin" sweep "$work/spec.json" --out "$work/sweep" > "$work/again.log" 2>&1 ||
+  fail "the sweep again exited with $?"
+grep -q '^local: 0 of 2 jobs to run' "$work/again.log" || fail "the sweep again runs a job"
+echo "a run with no answer is a finished job of the sweep, counted apart and left out of the means"

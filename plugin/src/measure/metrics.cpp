@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "rheofeed/measure/metrics.hpp"
 #include "rheofeed/measure/statistics.hpp"
+#include "rheofeed/number_format.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -399,6 +400,36 @@ class RunMeter : public RunObserver {
 };
 
 }  // namespace
+
+RunAnswer runAnswer(const RunMetrics& run, const std::string& bound_name) {
+  RunAnswer a;
+  const int lost = run.health.partsLost();
+  const std::string spawned = std::to_string(run.parts);
+  if (run.parts <= 0) {
+    a.why.push_back("spawned no part");
+  } else if (run.drift_parts == 0 && run.feeder.exit_times.empty() && lost >= run.parts) {
+    a.why.push_back("lost all " + spawned + " parts it spawned");
+  } else {
+    if (run.drift_parts == 0 && run.feeder.exit_times.empty()) {
+      a.why.push_back("measured none of its " + spawned + " parts (" + std::to_string(lost) +
+                      " lost, " + std::to_string(run.feeder.spawned_beyond_exit) +
+                      " spawned beyond the exit plane)");
+    }
+    // The share, not lost > bound x parts: 57 of 100 is not more than 0.57 (0.57 x 100 rounds
+    // to 56.99999999999999).
+    const double share = double(lost) / run.parts;
+    if (!(run.max_lost_fraction >= 0 && run.max_lost_fraction <= 1)) {
+      a.why.push_back("has no bound to judge its " + std::to_string(lost) + " lost parts by: " +
+                      bound_name + " " + formatNumber(run.max_lost_fraction) + " is not in [0, 1]");
+    } else if (share > run.max_lost_fraction) {
+      a.why.push_back("lost " + std::to_string(lost) + " of " + spawned + " parts (" +
+                      formatNumber(100 * share, 3) + " %), more than " + bound_name + " " +
+                      formatNumber(run.max_lost_fraction));
+    }
+  }
+  a.trusted = a.why.empty();
+  return a;
+}
 
 RunMetrics measureRun(const Scene& scene, Method method, const Progress& progress,
                       const std::vector<RunObserver*>& observers) {

@@ -167,6 +167,16 @@ std::string summaryJson(const RunMetrics& r) {
   j["time_step_s"] = r.time_step;
   j["parts"] = r.parts;
   j["drift_unit"] = r.angular ? "rad/s" : "m/s";
+  // The verdict before the numbers it judges (runAnswer), so that a reader of this file alone
+  // sees whether they are the run's answer.
+  const RunAnswer answer = runAnswer(r);
+  const int lost = r.health.partsLost();
+  j["answer"] = {
+      {"trusted", answer.trusted},
+      {"why", answer.why},
+      {"parts_lost", lost},
+      {"lost_fraction", r.parts > 0 ? OrderedJson(double(lost) / r.parts) : OrderedJson()},
+      {"max_lost_fraction", r.max_lost_fraction}};
   // null, not 0: no part measured, and no confidence interval over fewer than two parts
   j["mean_drift"] = r.drift_parts > 0 ? OrderedJson(r.mean_drift) : OrderedJson();
   j["mean_drift_ci95"] =
@@ -205,14 +215,22 @@ std::vector<std::string> writeRunOutputs(const RunMetrics& run, const std::strin
   written.push_back(base.string() + ".json");
 
   std::ostringstream gp;
+  // A run with no answer says so on its plot too (in red): the curve is not the scene's drift.
+  std::string no_answer;
+  for (const std::string& why : runAnswer(run).why) {
+    no_answer += (no_answer.empty() ? "no answer: " : "; ") + why;
+  }
   gp << "set datafile separator ','\n"
      << "set key bottom right\nset grid\n"
      << "set xlabel 'time (s)'\nset ylabel '"
      << (run.angular ? "mean angular drift about the axis (rad/s)" : "mean drift velocity (m/s)")
      << "'\n"
      << "set title '" << run.scene << ": " << toString(run.method) << ", h = " << run.time_step
-     << " s, " << run.parts << " parts'\n"
-     << "plot ";
+     << " s, " << run.parts << " parts'\n";
+  if (!no_answer.empty()) {
+    gp << "set label 1 '" << no_answer << "' at graph 0.02, graph 0.95 tc rgb '#c00000'\n";
+  }
+  gp << "plot ";
   // the band only where there is one (two parts or more; the CSV's field is empty otherwise)
   if (ci95Defined(run.parts)) {
     gp << "$data using 1:($3-$4):($3+$4) with filledcurves fc rgb '#c0d0f0' title '95 % CI', ";

@@ -138,6 +138,13 @@ struct DriftField {
   std::optional<Twist> calibrated_drift;
 };
 
+/// The default of RunMetrics::max_lost_fraction (dimensionless): a run that loses more than a
+/// tenth of the parts it spawned has no answer. A lost part (tunnelled, fallen, blown up) is not a
+/// random one of the parts, so the mean over the others is biased by which were lost; a tenth
+/// keeps that bias small next to a typical run's 95 % interval, and is a share a user sees in the
+/// run's stderr and JSON well before it reaches the bound.
+constexpr double kDefaultMaxLostFraction = 0.1;
+
 /// The result of one run.
 struct RunMetrics {
   std::string scene;  ///< Scene::name
@@ -185,6 +192,10 @@ struct RunMetrics {
   double real_time_factor = 0;
   /// What the run lost, could not trust or ignored (simulation.hpp).
   RunHealth health;
+  /// The largest share of the spawned parts the run may lose (RunHealth::partsLost() / parts,
+  /// in [0, 1]) and still have an answer (runAnswer). measureRun sets the default; a caller with
+  /// its own bound (`rheofeed run --max-lost-fraction`) sets it before writing the outputs.
+  double max_lost_fraction = kDefaultMaxLostFraction;
   /// The dynamics settings the engine applied (Simulation::appliedSolver: iterations, warm
   /// start, ERP, CFM, contact surface...; empty where they do not apply to the method).
   AppliedSolver solver;
@@ -194,6 +205,30 @@ struct RunMetrics {
   /// Output rate, first exit, exit orientation per family.
   FeederMetrics feeder;
 };
+
+/// Whether a run's numbers are its answer (runAnswer). Not trusted: the run's outputs are written
+/// as measured, but its mean drift, throughput and exit metrics are not the scene's (a
+/// `rheofeed run` exits with its no-answer code, a sweep leaves the seed out of its means).
+struct RunAnswer {
+  bool trusted = true;
+  /// Why not, one reason each, worded to follow the method's name ("ode_rheonomic lost all 2
+  /// parts it spawned"); empty when trusted.
+  std::vector<std::string> why;
+};
+
+/// The one rule of whether a run has an answer: it has none when it
+///   - spawned no part ("spawned no part");
+///   - measured no part and saw none cross the exit plane: every part lost ("lost all N parts
+///     it spawned"), or none measured ("measured none of its N parts (L lost, B spawned beyond
+///     the exit plane)");
+///   - lost more than run.max_lost_fraction of the parts it spawned, RunHealth::partsLost() /
+///     RunMetrics::parts > max_lost_fraction ("lost L of N parts (P %), more than
+///     <bound_name> F"; not said again when it lost them all).
+/// A bound that is not a number in [0, 1] judges nothing: the run then has no answer either
+/// ("has no bound to judge its L lost parts by: ..."). `bound_name` names the bound in these
+/// reasons: the run JSON's own key by default, a command's option (e.g. "--max-lost-fraction")
+/// in that command's messages.
+RunAnswer runAnswer(const RunMetrics& run, const std::string& bound_name = "max_lost_fraction");
 
 /// Runs `scene` with `method` for its duration (runSimulation, run.hpp) and measures it (drift,
 /// health, and with an exit plane the FeederMetrics; a run with an exit plane that no part

@@ -58,7 +58,11 @@ std::vector<std::string> writeFeederOutputs(const FeederMetrics& feeder,
 std::string seriesCsv(const RunMetrics& run);
 
 /// One-line JSON summary of a run: all scalar fields; "scene_source" (RunMetrics::scene_file, or
-/// "built-in" for a scene built in code) and "rheofeed_version" (kVersion, version.hpp); a
+/// "built-in" for a scene built in code) and "rheofeed_version" (kVersion, version.hpp); before
+/// the mean drift, the verdict on it, "answer" (runAnswer, metrics.hpp): {"trusted" (false: the
+/// run's numbers are not its answer), "why" (the reasons, empty when trusted), "parts_lost",
+/// "lost_fraction" (parts_lost / parts; null with no part spawned), "max_lost_fraction" (the
+/// bound, RunMetrics::max_lost_fraction)}; a
 /// "solver" object with the settings the engine applied (RunMetrics::solver, AppliedSolver:
 /// engine, mode, iterations, tolerance, relaxed_solver, coulomb_iterations, ipm_rounds,
 /// warm_start, speculative_contacts, erp, cfm, max_correcting_velocity_mps, surface_layer_m and
