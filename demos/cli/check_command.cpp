@@ -52,6 +52,9 @@ int checkCommand(const SceneArgs& args) {
                                   : std::string();
     std::printf("note: fixture '%s' vibrates; rheonomic runs use drift model %s%s\n",
                 f.name.c_str(), toString(f.law.drift_model), missing.c_str());
+    if (uncheckedCalibration(f.law)) {
+      std::printf("note: %s\n", uncheckedCalibrationNote(f, args.scene).c_str());
+    }
   }
   std::printf("%s\n",
               hazards == 0 ? "no hazards" : (std::to_string(hazards) + " hazard(s)").c_str());

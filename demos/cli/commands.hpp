@@ -52,6 +52,10 @@ inline constexpr int kNoAnswerExitCode = 3;
 void noteIgnoredCycleOptions(const char* program, bool cycles_given, bool calibrated,
                              bool classical);
 
+/// Why the calibration of `fixture` (uncheckedCalibration, scene.hpp) cannot be checked
+/// against the scene, with the command that records it; said by `run` and `check` for `scene`.
+std::string uncheckedCalibrationNote(const scene::Fixture& fixture, const std::string& scene);
+
 /// `rheofeed check SCENE`: loads and validates the scene, then prints the hazards of the scene
 /// check (check.hpp) for each method at the step it would take. Exit code 0 when there is no
 /// hazard, 1 when there is one (printed on stdout), 2 when the scene or the command line is

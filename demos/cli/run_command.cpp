@@ -266,9 +266,10 @@ int runCommand(const RunArgs& args) {
                    "rheofeed run: calibration took %.1f s CPU; `rheofeed calibrate %s --out "
                    "NEW.json` saves it so that runs of NEW.json start at once\n",
                    c.cpu_seconds,
-                   (args.scene.scene + (args.scene.drift_model.empty()
-                                            ? std::string()
-                                            : " --drift-model " + args.scene.drift_model))
+                   (args.scene.scene +
+                    (args.scene.drift_model.empty() ? std::string()
+                                                    : " --drift-model " + args.scene.drift_model) +
+                    (args.calibrate.classical ? " --classical" : ""))
                        .c_str());
     } else if (any_rheonomic) {
       for (const Fixture& f : calibrated.fixtures) {
@@ -278,6 +279,12 @@ int runCommand(const RunArgs& args) {
                      f.law.drift_model == DriftModel::Local ? " (the local vibration law)"
                                                             : " (from the scene)");
       }
+    }
+    for (const Fixture& f : calibrated.fixtures) {  // a calibration that cannot be checked
+      if (!any_rheonomic || !uncheckedCalibration(f.law)) continue;
+      const std::string why = uncheckedCalibrationNote(f, args.scene.scene);
+      std::fprintf(stderr, "rheofeed run: warning: %s\n", why.c_str());
+      calibration_warnings.push_back(why);
     }
 
     const std::string unit = plan.scene.outputs.angular_drift ? "rad/s" : "m/s";
@@ -361,6 +368,15 @@ int runCommand(const RunArgs& args) {
     }
   });
   return code != 0 ? code : no_answer.empty() ? 0 : kNoAnswerExitCode;
+}
+
+std::string uncheckedCalibrationNote(const Fixture& fixture, const std::string& scene) {
+  return "fixture '" + fixture.name + "': the scene gives its calibration (" +
+         (fixture.law.drift_model == DriftModel::CalibratedDrift ? "calibrated drift"
+                                                                 : "efficiency factors") +
+         ") without calibrated_for: after a change of the vibration, gravity or mu since it was "
+         "measured it would be stale, and the run cannot tell (`rheofeed calibrate " +
+         scene + " --force --out NEW.json` measures it again and records what for)";
 }
 
 }  // namespace rheofeed::cli

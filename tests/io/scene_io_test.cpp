@@ -120,6 +120,7 @@ void expectSameScene(const Scene& a, const Scene& b) {
       expectSame(la.calibrated_for->gravity, lb.calibrated_for->gravity,
                  w + ".calibrated_for.gravity");
       EXPECT_EQ(la.calibrated_for->mu, lb.calibrated_for->mu) << w;
+      EXPECT_EQ(la.calibrated_for->method, lb.calibrated_for->method) << w;
     }
     EXPECT_EQ(la.has_calibrated_drift, lb.has_calibrated_drift) << w;
     expectSame(la.calibrated_drift, lb.calibrated_drift, w + ".calibrated_drift");
@@ -250,7 +251,7 @@ Scene everyFieldScene() {
   bowl.law.calibrated_drift = {{0, 0, 0.0019}, {0, 0, 0.4}, {-3, 0, 0}};
   bowl.law.drift_model = DriftModel::LocalSampled;            // the calibrated drift kept beside it
   bowl.law.efficiency = {0.8123456789012345, 1, 1.0 / 3, 0};  // boxes, balls, pins, nuts
-  bowl.law.calibrated_for = CalibrationBasis{v, {0.1, 0, -9.7}, 0.45};
+  bowl.law.calibrated_for = CalibrationBasis{v, {0.1, 0, -9.7}, 0.45, "sampling"};
   bowl.law.calibrated_for->vibration.amplitude = 2.5e-4;  // calibrated for another amplitude
   s.fixtures.push_back(bowl);
 

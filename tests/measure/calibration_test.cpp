@@ -154,9 +154,15 @@ TEST(StaleCalibration, AChangedVibrationGravityOrMuMakesTheCalibrationStaleNamin
   Scene local = louder;  // the local law uses no calibration
   local.fixtures[0].law.drift_model = DriftModel::Local;
   EXPECT_EQ(staleCalibration(local, 0), "");
-  Scene by_hand = louder;  // a drift given without its basis cannot be checked
+  Scene by_hand = louder;  // a drift given without its basis cannot be checked, and says so
   by_hand.fixtures[0].law.calibrated_for.reset();
   EXPECT_EQ(staleCalibration(by_hand, 0), "");
+  EXPECT_TRUE(uncheckedCalibration(by_hand.fixtures[0].law));
+  EXPECT_FALSE(uncheckedCalibration(louder.fixtures[0].law));
+  EXPECT_FALSE(uncheckedCalibration(local.fixtures[0].law));
+  Scene moved_axis = calibrated;  // an axis without a torsion moves nothing
+  moved_axis.fixtures[0].law.vibration.axis_origin = {1, 2, 0};
+  EXPECT_EQ(staleCalibration(moved_axis, 0), "");
 }
 
 TEST(StaleCalibration, LocalSampledEfficienciesKeepWhatTheyWereMeasuredFor) {
@@ -185,9 +191,13 @@ TEST(CalibrateScene, CalibratesAStaleCalibrationAgainAndSaysWhy) {
   options.classical = true;
   calibrateScene(s, options, "test", log);
   const double first = s.fixtures[0].law.calibrated_drift.linear.x;
-  // At 60 Hz (throw number 3.4 * 1.44 = 4.9) the drift is the classical model's there.
+  EXPECT_EQ(s.fixtures[0].law.calibrated_for->method, "classical");
+  // At 60 Hz (throw number 3.4 * 1.44 = 4.9) the drift is the classical model's there: a stale
+  // classical drift is redone by the model even without options.classical (as it was made).
   s.fixtures[0].law.vibration.frequency = 60;
+  options.classical = false;
   const CalibrateReport again = calibrateScene(s, options, "test", log);
+  EXPECT_EQ(s.fixtures[0].law.calibrated_for->method, "classical");
   EXPECT_EQ(again.calibrated, 1);
   EXPECT_EQ(again.given, 0);
   ASSERT_EQ(again.stale.size(), 1u);

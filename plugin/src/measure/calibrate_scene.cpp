@@ -79,16 +79,20 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
     }
     std::ostringstream line;
     if (law.drift_model == DriftModel::CalibratedDrift) {
-      std::fprintf(
-          log, "%s: calibrating fixture '%s' (drift model calibrated_drift, %s)...\n",
-          label.c_str(), name.c_str(),
-          options.classical ? "classical single-part model" : "short full-vibration sample run");
+      // A stale drift from the classical model is redone by it, as the scene was calibrated.
+      const bool as_before =
+          !options.classical && !stale.empty() && law.calibrated_for->method == "classical";
+      const bool classical = options.classical || as_before;
+      std::fprintf(log, "%s: calibrating fixture '%s' (drift model calibrated_drift, %s%s)...\n",
+                   label.c_str(), name.c_str(),
+                   classical ? "classical single-part model" : "short full-vibration sample run",
+                   as_before ? ", as the scene's stale drift was" : "");
       std::fflush(log);
       CalibrationSettings sampling;
       sampling.warmup_cycles = options.warmup_cycles;
       sampling.measure_cycles = options.measure_cycles;
-      const Calibration c = options.classical ? calibrateClassical(scene, fixture)
-                                              : calibrateBySampling(scene, fixture, sampling);
+      const Calibration c = classical ? calibrateClassical(scene, fixture)
+                                      : calibrateBySampling(scene, fixture, sampling);
       line << "fixture '" << name << "': calibrated_drift ";
       if (law.vibration.torsion_amplitude > 0) {
         line << c.value << " +- " << c.ci95 << " rad/s";
@@ -97,7 +101,7 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
       }
       line << ", " << c.how << ", " << c.cpu_seconds << " s CPU";
       report.cpu_seconds += c.cpu_seconds;
-      if (!options.classical) {  // the classical model has no sampling interval to widen
+      if (!classical) {  // the classical model has no sampling interval to widen
         note_imprecision(imprecision("fixture '" + name + "': the calibrated drift " +
                                          formatNumber(c.value) + " +- " + formatNumber(c.ci95),
                                      c.value, c.ci95, options));
@@ -116,21 +120,22 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
       settings.measure_cycles = options.measure_cycles;
       Scene sampled = scene;
       sampled.fixtures[i].law.efficiency.clear();
+      const std::vector<std::string> families = familyKeys(scene.parts);  // "name[k]" if repeated
       for (std::size_t k = 0; k < scene.parts.size(); ++k) {
         std::fprintf(log,
                      "%s: calibrating fixture '%s', part family '%s' (drift model "
                      "local_sampled: full-vibration sample at %d steps per cycle against the "
                      "local law at h = %g s)...\n",
-                     label.c_str(), name.c_str(), scene.parts[k].name.c_str(),
-                     settings.steps_per_cycle, settings.rheonomic_time_step);
+                     label.c_str(), name.c_str(), families[k].c_str(), settings.steps_per_cycle,
+                     settings.rheonomic_time_step);
         std::fflush(log);
         const EfficiencyCalibration c =
             calibrateEfficiency(sampled, fixture, static_cast<int>(k), settings);
-        line << (k ? "; " : "") << "fixture '" << name << "', family '" << scene.parts[k].name
+        line << (k ? "; " : "") << "fixture '" << name << "', family '" << families[k]
              << "': efficiency " << c.efficiency << " +- " << c.ci95 << " (" << c.how << ", "
              << c.cpu_seconds << " s CPU)";
         report.cpu_seconds += c.cpu_seconds;
-        note_imprecision(imprecision("fixture '" + name + "', part family '" + scene.parts[k].name +
+        note_imprecision(imprecision("fixture '" + name + "', part family '" + families[k] +
                                          "': the efficiency " + formatNumber(c.efficiency) +
                                          " +- " + formatNumber(c.ci95),
                                      c.efficiency, c.ci95, options));

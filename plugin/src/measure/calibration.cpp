@@ -137,6 +137,7 @@ Calibration calibrateClassical(const Scene& scene, int fixture) {
   Calibration c;
   c.fixture = fixture;
   c.how = "classical single-part model";
+  c.method = "classical";
   const Vec3 velocity = drift.mean_speed * track.conveying_direction;
   if (screw) {
     c.value = dot(velocity, along) / norm(radial);
@@ -161,7 +162,8 @@ Scene withCalibration(Scene scene, const Calibration& calibration) {
   law.calibrated_drift = calibration.drift;
   law.drift_model = DriftModel::CalibratedDrift;
   law.efficiency.clear();
-  law.calibrated_for = CalibrationBasis{law.vibration, scene.gravity, scene.material.mu};
+  law.calibrated_for =
+      CalibrationBasis{law.vibration, scene.gravity, scene.material.mu, calibration.method};
   return scene;
 }
 
@@ -262,7 +264,8 @@ Scene withEfficiency(Scene scene, const EfficiencyCalibration& calibration) {
   law.drift_model = DriftModel::LocalSampled;
   if (law.efficiency.size() != scene.parts.size()) law.efficiency.assign(scene.parts.size(), 1.0);
   law.efficiency[static_cast<std::size_t>(calibration.family)] = calibration.efficiency;
-  law.calibrated_for = CalibrationBasis{law.vibration, scene.gravity, scene.material.mu};
+  law.calibrated_for =
+      CalibrationBasis{law.vibration, scene.gravity, scene.material.mu, "sampling"};
   return scene;
 }
 

@@ -595,11 +595,16 @@ std::string staleCalibration(const Scene& scene, int fixture) {
   // an edit of the scene is.
   compare("amplitude (m)", formatNumber(was.vibration.amplitude), formatNumber(v.amplitude));
   compare("frequency (Hz)", formatNumber(was.vibration.frequency), formatNumber(v.frequency));
-  compare("direction", vec(was.vibration.direction), vec(v.direction));
+  // A direction without a translation, an axis without a torsion, moves nothing.
+  if (was.vibration.amplitude != 0 || v.amplitude != 0) {
+    compare("direction", vec(was.vibration.direction), vec(v.direction));
+  }
   compare("torsion amplitude (rad)", formatNumber(was.vibration.torsion_amplitude),
           formatNumber(v.torsion_amplitude));
-  compare("axis origin (m)", vec(was.vibration.axis_origin), vec(v.axis_origin));
-  compare("axis direction", vec(was.vibration.axis_direction), vec(v.axis_direction));
+  if (was.vibration.torsion_amplitude != 0 || v.torsion_amplitude != 0) {
+    compare("axis origin (m)", vec(was.vibration.axis_origin), vec(v.axis_origin));
+    compare("axis direction", vec(was.vibration.axis_direction), vec(v.axis_direction));
+  }
   compare("gravity (m/s^2)", vec(was.gravity), vec(scene.gravity));
   compare("mu", formatNumber(was.mu), formatNumber(scene.material.mu));
   if (changed.empty()) return "";
@@ -607,6 +612,11 @@ std::string staleCalibration(const Scene& scene, int fixture) {
          (law.drift_model == DriftModel::CalibratedDrift ? "calibrated drift was"
                                                          : "part efficiency factors were") +
          " measured for another feeder: " + changed;
+}
+
+bool uncheckedCalibration(const FeederLaw& law) {
+  return law.kind == FeederLaw::Kind::Vibration && law.drift_model != DriftModel::Local &&
+         !lacksCalibration(law) && !law.calibrated_for;
 }
 
 bool needsCalibration(const Scene& scene) {

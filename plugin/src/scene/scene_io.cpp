@@ -386,6 +386,10 @@ void readLaw(const json& v, const std::string& path, FeederLaw& law,
       vibration.finish();
       b.req("gravity", was.gravity);
       b.req("mu", was.mu, Range::NonNegative);
+      if (b.opt("method", was.method) && was.method != "classical" && was.method != "sampling") {
+        fail(b.at("method"),
+             "unknown calibration method \"" + was.method + "\"; expected classical or sampling");
+      }
       b.finish();
     }
     // Without drift_model: a law that carries a calibrated drift keeps using it (files written

@@ -144,6 +144,9 @@ ojson toJson(const FeederLaw& law, const std::vector<PartSpec>& parts) {
         out["calibrated_for"] = ojson{{"vibration", toJson(law.calibrated_for->vibration)},
                                       {"gravity", toJson(law.calibrated_for->gravity)},
                                       {"mu", law.calibrated_for->mu}};
+        if (!law.calibrated_for->method.empty()) {
+          out["calibrated_for"]["method"] = law.calibrated_for->method;
+        }
       }
       return out;
     }

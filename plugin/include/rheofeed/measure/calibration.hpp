@@ -38,7 +38,10 @@ struct CalibrationSettings {
 struct Calibration {
   int fixture = -1;
   std::string how;  ///< "full-vibration sample (ODE)" / "classical model" / ...
-  Twist drift;      ///< the equivalent drift field (world frame)
+  /// "sampling" (calibrateBySampling) or "classical" (calibrateClassical): kept with the drift
+  /// (CalibrationBasis::method) so that a stale one is redone the same way.
+  std::string method = "sampling";
+  Twist drift;  ///< the equivalent drift field (world frame)
   /// Translation: drift speed along the conveying direction (m/s); screw: angular drift about
   /// the axis (rad/s).
   double value = 0;

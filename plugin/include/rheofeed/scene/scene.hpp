@@ -111,6 +111,9 @@ struct CalibrationBasis {
   Vibration vibration;
   Vec3 gravity{0, 0, -9.81};  ///< (m/s^2, world)
   double mu = 0;              ///< the material's friction coefficient (dimensionless)
+  /// How it was measured: "classical" (the classical single-part model), "sampling" (a
+  /// full-vibration sample run), "" (not known). A stale calibration is redone the same way.
+  std::string method;
 };
 
 /// Largest part efficiency factor (dimensionless), as FeederSet::setPartEfficiency accepts.
@@ -374,6 +377,12 @@ bool lacksCalibration(const FeederLaw& law);
 /// fits, when the law uses no calibration, or when its basis is not known. Phase is not
 /// compared (it does not change a steady drift).
 std::string staleCalibration(const Scene& scene, int fixture);
+
+/// True when `law`'s drift model uses a calibration (a calibrated drift, or local_sampled's
+/// efficiency factors) that does not say what it was measured for (no calibrated_for: given by
+/// hand, or written before it was kept): a change of the vibration, gravity or mu since cannot
+/// be noticed. Callers say so (`rheofeed run`, `rheofeed check`).
+bool uncheckedCalibration(const FeederLaw& law);
 
 /// True when a rheonomic run of `scene` needs a calibration first (a fixture lacksCalibration,
 /// or its calibration is stale: staleCalibration).
