@@ -293,10 +293,11 @@ int collect(const Folder& folder, const Manifest& manifest) {
     for (std::size_t k = 0; k < metrics; ++k) {
       if (std::none_of(rows[mt].begin(), rows[mt].end(),
                        [&](const Row& r) { return std::isfinite(r.metrics[k].mean); })) {
-        std::printf(
-            "collect: %s (%s) has no value at any point (null in every run's JSON): "
-            "not plotted\n",
-            manifest.metrics[k].name.c_str(), manifest.methods[mt].c_str());
+        std::printf("collect: %s (%s) has no value at any point (%s): not plotted\n",
+                    manifest.metrics[k].name.c_str(), manifest.methods[mt].c_str(),
+                    unanswered.empty() ? "null in every run's JSON"
+                                       : "null in the JSON of every run with an answer; the "
+                                         "runs with no answer are left out");
         continue;
       }
       for (std::size_t p = 0; p < manifest.parameters.size(); ++p) {
@@ -340,6 +341,31 @@ int collect(const Folder& folder, const Manifest& manifest) {
                  "in sweep.csv's seeds_no_answer, left out of its means and plots):\n",
                  unanswered.size(), total);
     for (const std::string& u : unanswered) std::fprintf(stderr, "  %s\n", u.c_str());
+    std::fflush(stderr);
+  }
+  // Points whose runs had scene-check hazards (a unit slip, a step too coarse): their numbers
+  // stand in sweep.csv, but so does the warning count, and stderr names them.
+  const auto hazard_key = std::find(healthKeys().begin(), healthKeys().end(), "scene_check");
+  const std::size_t hazard_column = static_cast<std::size_t>(hazard_key - healthKeys().begin());
+  std::vector<std::string> warned;
+  for (std::size_t mt = 0; mt < methods; ++mt) {
+    for (const Row& row : rows[mt]) {
+      if (!(row.health[hazard_column] > 0)) continue;
+      std::string where = "point " + std::to_string(row.point) + " (";
+      for (std::size_t p = 0; p < manifest.parameters.size(); ++p) {
+        where += (p ? ", " : "") + manifest.parameters[p].name + " " + num(row.values[p]);
+      }
+      warned.push_back(where + "), " + manifest.methods[mt] + ": " +
+                       num(row.health[hazard_column]) + " hazard warnings over its seeds");
+    }
+  }
+  if (!warned.empty()) {
+    std::fflush(stdout);
+    std::fprintf(stderr,
+                 "collect: %zu point(s) ran with scene-check hazards (sweep.csv's scene_check "
+                 "column; each run's JSON scene_check and the job's run.log say which):\n",
+                 warned.size());
+    for (const std::string& w : warned) std::fprintf(stderr, "  %s\n", w.c_str());
     std::fflush(stderr);
   }
   if (problems.empty()) {

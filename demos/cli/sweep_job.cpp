@@ -383,7 +383,8 @@ const std::vector<std::string>& healthKeys() {
                                                 "solver_unconverged_steps",
                                                 "friction_dropped_contacts",
                                                 "gyroscopic_fallback_steps",
-                                                "ignored_settings"};
+                                                "ignored_settings",
+                                                "scene_check"};
   return keys;
 }
 
@@ -701,6 +702,8 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
       }
       record["metrics"][method] = values;
       record["health"][method] = run.contains("health") ? run["health"] : Json();
+      // The scene check's hazards of the run (a unit slip warns there): counted in sweep.csv.
+      if (run.contains("scene_check")) record["health"][method]["scene_check"] = run["scene_check"];
       // Why a run has no answer, from its own verdict (runAnswer).
       const Json* why =
           run.contains("answer") && run["answer"].contains("why") ? &run["answer"]["why"] : nullptr;
