@@ -325,11 +325,17 @@ int runCommand(const RunArgs& args) {
       if (ci95Defined(r.drift_parts)) std::snprintf(ci, sizeof ci, "%.5f", r.mean_drift_ci95);
       char drift[32] = "n/a", height[32] = "n/a";  // no part measured
       if (r.drift_parts > 0) std::snprintf(drift, sizeof drift, "%.5f", r.mean_drift);
+      // the mean over fewer parts than spawned (lost, inside a fixture, beyond the exit) says so
+      if (r.drift_parts > 0 && r.drift_parts < r.parts) {
+        std::snprintf(drift, sizeof drift, "%.5f (of %d)", r.mean_drift, r.drift_parts);
+      }
+      char throughput[32] = "n/a";  // no exit plane: nothing to count through
+      if (r.feeder.exit_plane) std::snprintf(throughput, sizeof throughput, "%.2f", r.throughput);
       if (r.displacement_parts > 0) {
         std::snprintf(height, sizeof height, "%.4f", r.vertical_displacement);
       }
-      std::printf("| %s | %.3g | %d | %s | %s | %s | %.2f | %.2f | %.4f | %d | %.1f %% | %s |\n",
-                  toString(m), r.time_step, r.parts, drift, ci, height, r.throughput, r.cpu_seconds,
+      std::printf("| %s | %.3g | %d | %s | %s | %s | %s | %.2f | %.4f | %d | %.1f %% | %s |\n",
+                  toString(m), r.time_step, r.parts, drift, ci, height, throughput, r.cpu_seconds,
                   r.real_time_factor, h.partsLost(),
                   100.0 * h.coulomb_fallback_steps / std::max(1L, h.steps),
                   answer.trusted ? "yes" : "no (see stderr)");

@@ -209,6 +209,14 @@ TEST(SummaryJson, SaysWhetherTheRunHasAnAnswer) {
   EXPECT_TRUE(json::parse(summaryJson(r))["answer"]["lost_fraction"].is_null());
 }
 
+TEST(SummaryJson, HasAThroughputOnlyThroughAnExitPlane) {
+  RunMetrics r = run();
+  r.feeder.exit_plane = true;
+  EXPECT_DOUBLE_EQ(json::parse(summaryJson(r))["throughput_parts_per_s"].get<double>(), 1.5);
+  r.feeder.exit_plane = false;
+  EXPECT_TRUE(json::parse(summaryJson(r))["throughput_parts_per_s"].is_null());
+}
+
 TEST(SummaryJson, ParsesToTheRunMetricsWritten) {
   const RunMetrics r = run();
   const std::string text = summaryJson(r);
@@ -222,7 +230,9 @@ TEST(SummaryJson, ParsesToTheRunMetricsWritten) {
   EXPECT_EQ(j["mean_drift"].get<double>(), r.mean_drift);
   EXPECT_EQ(j["mean_drift_ci95"].get<double>(), r.mean_drift_ci95);
   EXPECT_EQ(j["vertical_displacement_m"].get<double>(), r.vertical_displacement);
-  EXPECT_DOUBLE_EQ(j["throughput_parts_per_s"].get<double>(), 1.5);
+  // The scene of run() has no exit plane: no throughput (null, not the 1.5 set in the metrics).
+  EXPECT_TRUE(j["throughput_parts_per_s"].is_null());
+  EXPECT_EQ(j["drift_parts"], 12);
   EXPECT_DOUBLE_EQ(j["simulated_seconds"].get<double>(), 10);
   // the run's setting written back (simulated seconds, the start of the mean drift's window)
   EXPECT_DOUBLE_EQ(j["warmup_s"].get<double>(), r.warmup);

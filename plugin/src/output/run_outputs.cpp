@@ -179,11 +179,13 @@ std::string summaryJson(const RunMetrics& r) {
       {"max_lost_fraction", r.max_lost_fraction}};
   // null, not 0: no part measured, and no confidence interval over fewer than two parts
   j["mean_drift"] = r.drift_parts > 0 ? OrderedJson(r.mean_drift) : OrderedJson();
+  j["drift_parts"] = r.drift_parts;  // the parts behind the mean (parts: all spawned)
   j["mean_drift_ci95"] =
       ci95Defined(r.drift_parts) ? OrderedJson(r.mean_drift_ci95) : OrderedJson();
   j["vertical_displacement_m"] =
       r.displacement_parts > 0 ? OrderedJson(r.vertical_displacement) : OrderedJson();
-  j["throughput_parts_per_s"] = r.throughput;
+  // no exit plane: no exit to count through (null, not 0 parts/s)
+  j["throughput_parts_per_s"] = r.feeder.exit_plane ? OrderedJson(r.throughput) : OrderedJson();
   j["cpu_seconds"] = r.cpu_seconds;
   j["simulated_seconds"] = r.simulated_seconds;
   j["real_time_factor"] = r.real_time_factor;

@@ -74,7 +74,9 @@ std::string seriesCsv(const RunMetrics& run);
 /// contacts, wall_contacts, cells_computed, model_runs, model_cpu_s (s); corners_at_start from
 /// RunHealth::local_law_corners_at_start). Numbers are written in their shortest form that reads
 /// back exactly; a number that is not finite, a mean drift or vertical displacement with no
-/// part measured and a 95 % interval over fewer than two parts are null.
+/// part measured, the throughput of a scene without an exit plane and a 95 % interval over
+/// fewer than two parts are null. "drift_parts" is the number of parts behind the mean drift
+/// ("parts": all spawned).
 std::string summaryJson(const RunMetrics& run);
 
 /// Writes <stem>.csv, <stem>.json and, when gnuplot is available, <stem>.png (mean drift vs time
