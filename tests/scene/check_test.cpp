@@ -240,6 +240,22 @@ TEST(SceneCheck, MassRatioFiresWithTheMassesFromDensitiesAndEdges) {
   EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::MassRatio).empty());
 }
 
+// Equal parts below the measured range (X = e / (g h^2) under 5): the warning does not call them
+// a heavy and a light part, nor advise closer masses.
+TEST(SceneCheck, EqualPartsBelowTheMeasuredRangeAreNotCalledHeavyAndLight) {
+  Scene s;
+  s.fixtures.push_back(floorBox(0.1));
+  s.parts.push_back(cubes(0.004, 1000, {-0.3, -0.3, 0.02}, {0.3, 0.3, 0.05}, 10));  // X = 4.1
+  s.solver.time_step = 0.01;
+  const std::vector<Hazard> m =
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::MassRatio);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_NE(m[0].message.find("the parts are of equal mass"), std::string::npos) << m[0].message;
+  EXPECT_EQ(m[0].message.find("heavy part"), std::string::npos) << m[0].message;
+  EXPECT_EQ(m[0].safe_setting.find("closer masses"), std::string::npos) << m[0].safe_setting;
+  EXPECT_NE(m[0].safe_setting.find("thicker parts"), std::string::npos) << m[0].safe_setting;
+}
+
 // The table's limits are ODE's behaviour: at the limit the stack holds (penetration below a
 // quarter edge, as measured), at ten times the limit it does not. Three points of the table.
 TEST(SceneCheck, OdeQuickstepHoldsAStackAtTheTableLimitAndNotAtTenTimesIt) {
@@ -350,12 +366,36 @@ TEST(SceneCheck, AnAmplitudeInMillimetresGivenAsMetresIsAnExtremeVibration) {
   EXPECT_NEAR(h[0].value, 0.2 * w * w, 1e-9 * h[0].value);  // A w^2 = 19739 m/s^2
   EXPECT_NEAR(h[0].limit, kMaxFeederAcceleration * 9.81, 1e-9);
   EXPECT_EQ(h[0].where, "fixtures[0].law.vibration.amplitude");
-  EXPECT_NE(h[0].message.find("(2012 g: amplitude 0.2 m, 50 Hz)"), std::string::npos) << h[0].message;
+  EXPECT_NE(h[0].message.find("(2012 g: amplitude 0.2 m, 50 Hz)"), std::string::npos)
+      << h[0].message;
   EXPECT_NE(h[0].message.find("in mm given as m"), std::string::npos) << h[0].message;
+  // or the frequency that would keep 0.2 m at 50 g: sqrt(50 g / 0.2) / (2 pi) = 7.88 Hz
+  EXPECT_NE(h[0].safe_setting.find("frequency <= 7.88 Hz at this amplitude"), std::string::npos)
+      << h[0].safe_setting;
   // The largest amplitude at 50 g and 50 Hz: 50 * 9.81 / w^2 = 4.97 mm.
   EXPECT_NE(h[0].safe_setting.find("amplitude <= 0.00497 m at 50 Hz"), std::string::npos)
       << h[0].safe_setting;
   EXPECT_EQ(toString(h[0].kind), std::string("extreme_vibration"));
+}
+
+// "angle_rad": 3 meant in degrees throws the parts at 172 degrees: backwards, away from the exit.
+TEST(SceneCheck, AThrowBeyondNinetyDegreesIsAgainstTheConveyingDirection) {
+  EXPECT_TRUE(ofKind(checkScene(vibratingTrackScene(0.2e-3, 50, 0.349066), Method::OdeRheonomic),
+                     Hazard::Kind::AgainstConveyingDirection)
+                  .empty());
+  const Scene slip = vibratingTrackScene(0.2e-3, 50, 3.0);
+  const std::vector<Hazard> h =
+      ofKind(checkScene(slip, Method::OdeRheonomic), Hazard::Kind::AgainstConveyingDirection);
+  ASSERT_EQ(h.size(), 1u);
+  EXPECT_NEAR(h[0].value, -1, 1e-12);  // the horizontal part is along -x, the drift along +x
+  EXPECT_NE(h[0].message.find("172 degrees above outputs.conveying_direction"), std::string::npos)
+      << h[0].message;
+  EXPECT_EQ(toString(h[0].kind), std::string("against_conveying_direction"));
+  Scene backwards = slip;  // a feeder meant to run the other way says so
+  backwards.outputs.conveying_direction = {-1, 0, 0};
+  EXPECT_TRUE(
+      ofKind(checkScene(backwards, Method::OdeRheonomic), Hazard::Kind::AgainstConveyingDirection)
+          .empty());
 }
 
 TEST(SceneCheck, ATorsionInDegreesGivenAsRadiansIsAnExtremeVibration) {

@@ -134,6 +134,8 @@ const char* toString(Hazard::Kind kind) {
       return "coarse_vibration_step";
     case Hazard::Kind::ExtremeVibration:
       return "extreme_vibration";
+    case Hazard::Kind::AgainstConveyingDirection:
+      return "against_conveying_direction";
     case Hazard::Kind::SpawnInsideFixture:
       return "spawn_inside_fixture";
     case Hazard::Kind::SpawnBelowRemoval:
@@ -168,6 +170,7 @@ std::vector<Hazard> checkScene(const Scene& scene, Method method) {
   checkMassRatio(c, out);
   checkCoarseVibrationStep(c, out);
   checkExtremeVibration(c, out);
+  checkConveyingSense(c, out);
   checkHighRestitution(c, out);
   for (std::size_t i = 0; i < scene.parts.size(); ++i) {
     checkSpawnStream(c, i, out);

@@ -192,7 +192,11 @@ void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out) {
                  "density, solver.iterations, solver.time_step";
       const double x = c.light_thickness / (c.g * c.h * c.h);
       std::ostringstream m;
-      if (one_family) {  // the size distribution's bounds
+      const bool equal = ratio <= 1 + 1e-9;  // equal parts: the limit is below 1
+      if (equal) {
+        m << "the parts are of equal mass (" << fmt(c.heaviest) << " kg, " << mm(c.light_thickness)
+          << " thick); ";
+      } else if (one_family) {  // the size distribution's bounds
         m << "the heaviest part " << idx("parts", c.heavy_family) << " can draw ("
           << fmt(c.heaviest) << " kg) is " << fmt(ratio) << " times its lightest ("
           << fmt(c.lightest) << " kg, " << mm(c.light_thickness) << " thick); ";
@@ -208,7 +212,8 @@ void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out) {
         << (limit < 1 ? ") is below the measured range, where even stacks of equal parts sank "
                         "into the floor"
                       : ") was measured to hold a ratio of " + fmt(limit))
-        << ": a heavy part resting on a light one crushes it into the floor";
+        << (equal ? ": a part resting on another can push it into the floor"
+                  : ": a heavy part resting on a light one crushes it into the floor");
       hz.message = m.str();
       std::ostringstream s;
       int need = 0;
@@ -225,7 +230,8 @@ void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out) {
       if (holds(safe_h)) s << c.step_field << " <= " << fmt(safe_h) << " s, or ";
       if (warm && ratio <= limitWith(k, c.h, false)) s << "solver.warm_start = false, or ";
       if (quickstep) s << "solver.ode_quickstep = false (Dantzig LCP, exact but slower), or ";
-      s << "parts of closer masses";
+      s << (equal ? "thicker parts (the limit grows with thickness / (g h^2))"
+                  : "parts of closer masses");
       hz.safe_setting = s.str();
       out.push_back(hz);
     }
@@ -286,18 +292,54 @@ void checkExtremeVibration(const CheckContext& c, std::vector<Hazard>& out) {
       m << ", torsion " << fmt(v.torsion_amplitude) << " rad at " << mm(reach) << " from the axis";
     }
     m << ", " << fmt(v.frequency) << " Hz); vibratory feeders run at a few g (throw numbers 1 to "
-      << "5): is a length in mm given as m, or an angle in degrees as rad? (the scene's units "
-         "are m and rad, or *_deg)";
+      << "5): is a length in mm given as m, an angle in degrees as rad, or a frequency in rad/s "
+         "as Hz? (the scene's units are m, rad or *_deg, and Hz)";
     hz.message = m.str();
     std::ostringstream s;
     s << "a peak acceleration <= " << fmt(kMaxFeederAcceleration) << " g: ";
     if (translation >= torsion) {
-      s << at << ".amplitude <= " << fmt(limit / (w * w)) << " m at " << fmt(v.frequency) << " Hz";
+      s << at << ".amplitude <= " << fmt(limit / (w * w)) << " m at " << fmt(v.frequency)
+        << " Hz, or " << at << ".frequency <= " << fmt(std::sqrt(limit / v.amplitude) / (2 * kPi))
+        << " Hz at this amplitude";
     } else {
       s << at << ".torsion_amplitude <= " << fmt(limit / (w * w * reach)) << " rad at "
         << fmt(v.frequency) << " Hz";
     }
     hz.safe_setting = s.str();
+    out.push_back(hz);
+  }
+}
+
+void checkConveyingSense(const CheckContext& c, std::vector<Hazard>& out) {
+  if (c.scene.outputs.angular_drift) return;  // a bowl: measured about an axis
+  const Vec3 d = c.scene.outputs.conveying_direction;
+  for (std::size_t f = 0; f < c.scene.fixtures.size(); ++f) {
+    const FeederLaw& law = c.scene.fixtures[f].law;
+    if (law.kind != FeederLaw::Kind::Vibration) continue;
+    const Vibration& v = law.vibration;
+    if (v.torsion_amplitude != 0 || v.amplitude == 0) continue;
+    // Parts hop along the vibration's horizontal part (NOTES section 5: a throw angle above
+    // the track). Straight up or nearly: no sense to judge.
+    const Vec3 across = v.direction - dot(v.direction, c.up) * c.up;
+    const double n = norm(across), nd = norm(d);
+    if (!(n > 1e-3) || !(nd > 0)) continue;
+    const double cosine = dot(across, d) / (n * nd);
+    if (!(cosine < 0)) continue;
+    Hazard hz;
+    hz.kind = Hazard::Kind::AgainstConveyingDirection;
+    hz.value = cosine;
+    hz.limit = 0;
+    hz.where = idx("fixtures", f) + ".law.vibration.direction, outputs.conveying_direction";
+    const double above = std::atan2(dot(v.direction, c.up), dot(v.direction, (1.0 / nd) * d));
+    hz.message = "fixture '" + c.scene.fixtures[f].name + "' vibrates " + fmt(above * 180 / kPi) +
+                 " degrees above outputs.conveying_direction, beyond 90: its horizontal part "
+                 "points against it (cosine " +
+                 fmt(cosine) +
+                 "), so the parts drift backwards, away from the exit (was a throw angle in "
+                 "degrees given as angle_rad?)";
+    hz.safe_setting =
+        "a throw angle between 0 and 90 degrees above the conveying direction (angle_deg), or "
+        "outputs.conveying_direction reversed for a feeder meant to run the other way";
     out.push_back(hz);
   }
 }

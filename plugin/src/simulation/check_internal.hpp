@@ -158,6 +158,7 @@ void checkFlushWalls(const CheckContext& c, std::vector<Hazard>& out);
 void checkMassRatio(const CheckContext& c, std::vector<Hazard>& out);
 void checkCoarseVibrationStep(const CheckContext& c, std::vector<Hazard>& out);
 void checkExtremeVibration(const CheckContext& c, std::vector<Hazard>& out);
+void checkConveyingSense(const CheckContext& c, std::vector<Hazard>& out);
 void checkHighRestitution(const CheckContext& c, std::vector<Hazard>& out);
 void checkSpawnStream(const CheckContext& c, std::size_t part, std::vector<Hazard>& out);
 void checkWeakCollider(const CheckContext& c, std::size_t part, std::vector<Hazard>& out);
