@@ -35,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "rheofeed/measure/metrics.hpp"
 #include "rheofeed/output/plot.hpp"
 
 namespace rheofeed::cli::sweep {
@@ -82,6 +83,8 @@ struct Spec {
   std::string name;                  ///< "name", else the file's stem
   std::filesystem::path scene_file;  ///< the base scene file (absolute)
   std::vector<std::string> methods;  ///< method names (run's --method)
+  /// Run's --max-lost-fraction ("max_lost_fraction", in [0, 1]): beyond it a job has no answer.
+  double max_lost_fraction = scene::kDefaultMaxLostFraction;
   std::vector<Parameter> parameters;
   int lhs_samples = 0;         ///< Latin hypercube samples (0: no such parameter)
   std::uint64_t lhs_seed = 0;  ///< its random seed
@@ -127,7 +130,8 @@ void prepareSweep(const Spec& spec, const Folder& folder);
 struct Manifest {
   std::string name;
   std::vector<std::string> methods;
-  std::vector<Parameter> parameters;  ///< name, pointer and scale
+  double max_lost_fraction = scene::kDefaultMaxLostFraction;  ///< Spec::max_lost_fraction
+  std::vector<Parameter> parameters;                          ///< name, pointer and scale
   std::vector<Metric> metrics;
   int map_x = -1, map_y = -1;
   SlurmSettings slurm;

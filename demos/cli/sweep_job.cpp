@@ -27,6 +27,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/sweep.hpp"
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/output/output.hpp"
 #include "rheofeed/version.hpp"
 
@@ -93,6 +94,7 @@ Json definitionJson(const Spec& spec) {
   for (const Metric& m : spec.metrics)
     metrics.push_back({{"name", m.name}, {"pointer", m.pointer}});
   return {{"methods", spec.methods},
+          {"max_lost_fraction", spec.max_lost_fraction},
           {"parameters", params},
           {"metrics", metrics},
           {"jobs", jobsJson(spec)}};
@@ -338,6 +340,8 @@ Manifest readManifest(const Folder& folder) {
     m.name = j.at("name").get<std::string>();
     const Json& d = j.at("definition");
     m.methods = d.at("methods").get<std::vector<std::string>>();
+    // manifests written before the key: run's default
+    m.max_lost_fraction = d.value("max_lost_fraction", scene::kDefaultMaxLostFraction);
     for (const Json& p : d.at("parameters")) {
       Parameter q;
       q.name = p.at("name").get<std::string>();
@@ -573,11 +577,18 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
   for (const std::string& m : manifest.methods) methods += (methods.empty() ? "" : ",") + m;
   // The jobs share one drift table (the local law's point-mass results, the same for every
   // scene): each reads what the jobs before it wrote and writes back what it added.
-  const std::vector<std::string> argv = {selfExe().string(),  "run",
-                                         scene_file.string(), "--out",
-                                         run_dir.string(),    "--no-animation",
-                                         "--method",          methods,
-                                         "--drift-table",     folder.driftTable().string()};
+  const std::vector<std::string> argv = {selfExe().string(),
+                                         "run",
+                                         scene_file.string(),
+                                         "--out",
+                                         run_dir.string(),
+                                         "--no-animation",
+                                         "--method",
+                                         methods,
+                                         "--drift-table",
+                                         folder.driftTable().string(),
+                                         "--max-lost-fraction",
+                                         formatNumber(manifest.max_lost_fraction, 17)};
   std::string command = "rheofeed";
   for (std::size_t k = 1; k < argv.size(); ++k) command += " " + shellQuoted(argv[k]);
 

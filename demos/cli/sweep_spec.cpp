@@ -19,6 +19,7 @@
 #include "cli/shipped_scenes.hpp"
 #include "cli/sweep.hpp"
 #include "rheofeed/measure/metrics.hpp"
+#include "rheofeed/number_format.hpp"
 #include "rheofeed/output/output.hpp"
 #include "rheofeed/scene/scene_io.hpp"
 
@@ -387,7 +388,7 @@ Spec loadSpec(const fs::path& file) {
   }
   r.keys(j, "spec",
          {"comment", "name", "scene", "methods", "set", "remove", "parameters", "latin_hypercube",
-          "seeds", "metrics", "map", "slurm"});
+          "seeds", "metrics", "map", "slurm", "max_lost_fraction"});
   spec.name = j.contains("name") ? r.string(j["name"], "name") : file.stem().string();
   if (!validName(spec.name))
     fail(file, "name", "\"" + spec.name + "\": use letters, digits, _ . -");
@@ -548,6 +549,17 @@ Spec loadSpec(const fs::path& file) {
     fail(
         file, "latin_hypercube",
         "missing: a parameter is sampled by a Latin hypercube; give {\"samples\": n, \"seed\": s}");
+  }
+
+  // The runs' bound on lost parts (rheofeed run --max-lost-fraction): a feeder with a reject
+  // slot loses parts by design.
+  if (j.contains("max_lost_fraction")) {
+    const double f = r.number(j["max_lost_fraction"], "max_lost_fraction");
+    if (!(f >= 0 && f <= 1)) {
+      fail(file, "max_lost_fraction",
+           "got " + formatNumber(f) + ": must be a fraction of the parts in [0, 1]");
+    }
+    spec.max_lost_fraction = f;
   }
 
   // Seeds: a list, or a count n (seeds 1..n); default the base scene's seed.

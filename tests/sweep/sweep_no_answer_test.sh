@@ -51,4 +51,12 @@ grep -q 'job 0001 (point 1, seed 1): ode_rheonomic lost 1 of 4 parts' "$work/swe
 "$bin" sweep "$work/spec.json" --out "$work/sweep" > "$work/again.log" 2>&1 ||
   fail "the sweep again exited with $?"
 grep -q '^local: 0 of 2 jobs to run' "$work/again.log" || fail "the sweep again runs a job"
+# A spec that allows a quarter of the parts lost (a feeder with a reject slot): both jobs ok.
+sed 's/"seeds": 1,/"seeds": 1, "max_lost_fraction": 0.25,/' "$work/spec.json" > "$work/spec_quarter.json"
+"$bin" sweep "$work/spec_quarter.json" --out "$work/quarter" > "$work/quarter.log" 2>&1 ||
+  fail "the sweep with max_lost_fraction 0.25 exited with $?: $(cat "$work/quarter.log")"
+grep -q '"status": "ok"' "$work/quarter/records/0001.json" ||
+  fail "with max_lost_fraction 0.25, job 0001 (a quarter lost) is not ok"
+grep -q -- '--max-lost-fraction' "$work/quarter/records/0001.json" ||
+  fail "job 0001's recorded command does not pass --max-lost-fraction"
 echo "a run with no answer is a finished job of the sweep, counted apart and left out of the means"
