@@ -301,6 +301,10 @@ int collect(const Folder& folder, const Manifest& manifest) {
         continue;
       }
       for (std::size_t p = 0; p < manifest.parameters.size(); ++p) {
+        // A parameter held at one value has no curve to draw (gnuplot would only warn).
+        std::set<double> values;
+        for (const Row& row : rows[mt]) values.insert(row.values[p]);
+        if (values.size() < 2) continue;
         plots += plotLines(manifest, rows[mt], mt, k, p,
                            out / (manifest.metrics[k].name + "_vs_" + manifest.parameters[p].name +
                                   suffix(manifest, mt) + ".png"));

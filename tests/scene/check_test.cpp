@@ -425,6 +425,30 @@ TEST(SceneCheck, ATorsionInDegreesGivenAsRadiansIsAnExtremeVibration) {
   EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::ExtremeVibration).empty());
 }
 
+// A spawn region beside the feeder: its parts fall past everything and are lost.
+TEST(SceneCheck, ASpawnRegionOverNothingFires) {
+  Scene s;
+  s.fixtures.push_back(floorBox(0.02));  // 1 m x 1 m around the origin
+  s.parts.push_back(cubes(0.01, 1000, {0.8, 0.8, 0.05}, {0.9, 0.9, 0.1}, 3));
+  const std::vector<Hazard> h =
+      ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnOverNothing);
+  ASSERT_EQ(h.size(), 1u);
+  EXPECT_EQ(h[0].where, "parts[0].spawn_min/spawn_max");
+  EXPECT_NE(h[0].message.find("x 0.8 to 0.9 m, y 0.8 to 0.9 m"), std::string::npos) << h[0].message;
+  s.parts[0].spawn_min = {0.4, 0.4, 0.05};  // over the floor's corner: some land, no hazard
+  EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnOverNothing).empty());
+  s.parts[0].spawn_min = {0.8, 0.8, 0.05};
+  Fixture ground;  // a plane under everything
+  ground.name = "ground";
+  Fixture::Geom plane;
+  plane.shape.kind = Shape::Kind::Plane;
+  plane.shape.plane_normal = {0, 0, 1};
+  plane.shape.plane_offset = -1;
+  ground.geoms.push_back(plane);
+  s.fixtures.push_back(ground);
+  EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnOverNothing).empty());
+}
+
 TEST(SceneCheck, SpawnInsideAFixtureAndBelowTheRemovalHeightFire) {
   Scene s;
   s.fixtures.push_back(floorBox(0.02));

@@ -37,4 +37,8 @@ grep -q 'extreme_vibration' "$work/sweep/jobs/0001/run/ode_rheonomic.json" ||
   fail "the run JSON of point 1 has no extreme_vibration warning"
 ! grep -q 'extreme_vibration' "$work/sweep/jobs/0000/run/ode_rheonomic.json" ||
   fail "the run JSON of point 0 (0.25 mm) has an extreme_vibration warning"
+# Parameters held at one value (the duration, the warm-up) get no curve, and gnuplot no warning.
+[ ! -e "$work/sweep/results/mean_drift_mps_vs_duration_s.png" ] ||
+  fail "a parameter held at one value was plotted"
+! grep -q 'empty x range' "$work/sweep_stderr.log" || fail "gnuplot warned of an empty x range"
 echo "a point whose runs warn in the scene check is counted and named by the sweep"

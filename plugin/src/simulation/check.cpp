@@ -138,6 +138,8 @@ const char* toString(Hazard::Kind kind) {
       return "against_conveying_direction";
     case Hazard::Kind::SpawnInsideFixture:
       return "spawn_inside_fixture";
+    case Hazard::Kind::SpawnOverNothing:
+      return "spawn_over_nothing";
     case Hazard::Kind::SpawnBelowRemoval:
       return "spawn_below_removal";
     case Hazard::Kind::SpawnStreamOverlap:
@@ -177,6 +179,7 @@ std::vector<Hazard> checkScene(const Scene& scene, Method method) {
     checkWeakCollider(c, i, out);
     checkSpawnInsideFixture(c, i, out);
     checkSpawnBelowRemoval(c, i, out);
+    checkSpawnOverNothing(c, i, out);
   }
   checkSkippedTests(c, out);
   return out;

@@ -483,6 +483,34 @@ void checkSpawnBelowRemoval(const CheckContext& c, std::size_t part, std::vector
   }
 }
 
+void checkSpawnOverNothing(const CheckContext& c, std::size_t part, std::vector<Hazard>& out) {
+  if (!(std::abs(c.up.z) > 0.99)) return;  // "under" is judged with gravity along z
+  const PartSpec& p = c.scene.parts[part];
+  Box3 region;
+  region.add(p.spawn_min);
+  region.add(p.spawn_max);
+  const double top = maxAlong(region, c.up);
+  for (const GeomInfo& gi : c.geoms) {
+    if (!gi.bounds.bounded) return;  // a plane or a mesh not loaded: cannot tell
+    const Box3& b = gi.bounds;
+    const bool overlaps = b.lo.x <= region.hi.x && b.hi.x >= region.lo.x && b.lo.y <= region.hi.y &&
+                          b.hi.y >= region.lo.y;
+    if (overlaps && minAlong(b, c.up) <= top) return;  // something under (or around) it
+  }
+  if (norm(p.initial_velocity) > 0) return;  // thrown: where it lands is not straight below
+  Hazard hz;
+  hz.kind = Hazard::Kind::SpawnOverNothing;
+  hz.value = std::isfinite(c.lowest_top) ? top - c.lowest_top : -kInf;
+  hz.limit = 0;
+  hz.where = idx("parts", part) + ".spawn_min/spawn_max";
+  hz.message = idx("parts", part) + " ('" + p.name + "') spawns over no fixture: nothing lies " +
+               "under its spawn region (x " + fmt(region.lo.x) + " to " + fmt(region.hi.x) +
+               " m, y " + fmt(region.lo.y) + " to " + fmt(region.hi.y) +
+               " m), so its parts fall to the removal height and are lost";
+  hz.safe_setting = "a spawn region over the feeder (in plan, within a fixture's footprint)";
+  out.push_back(hz);
+}
+
 void checkSkippedTests(const CheckContext& c, std::vector<Hazard>& out) {
   for (const CheckContext::Skipped& s : c.skipped) {
     Hazard hz;

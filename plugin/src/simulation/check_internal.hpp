@@ -164,6 +164,7 @@ void checkSpawnStream(const CheckContext& c, std::size_t part, std::vector<Hazar
 void checkWeakCollider(const CheckContext& c, std::size_t part, std::vector<Hazard>& out);
 void checkSpawnInsideFixture(const CheckContext& c, std::size_t part, std::vector<Hazard>& out);
 void checkSpawnBelowRemoval(const CheckContext& c, std::size_t part, std::vector<Hazard>& out);
+void checkSpawnOverNothing(const CheckContext& c, std::size_t part, std::vector<Hazard>& out);
 void checkSkippedTests(const CheckContext& c, std::vector<Hazard>& out);
 
 }  // namespace rheofeed::scene::checks

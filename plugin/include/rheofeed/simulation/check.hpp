@@ -52,6 +52,10 @@ struct Hazard {
     SpawnInsideFixture,
     /// A spawn region lies below Scene::removal_height: parts are removed as they appear.
     SpawnBelowRemoval,
+    /// Gravity vertical, and no fixture geom under a spawn region (none overlaps it in plan
+    /// below its top; no plane, no unloaded mesh): its parts fall to the removal height and
+    /// are lost. value: the region's height above the lowest fixture (m, -inf with none).
+    SpawnOverNothing,
     /// Parts spawned over time (PartSpec::rate > 0) faster than the region holds them side by
     /// side: more appear while one falls its own largest size than fit in the region (a region
     /// narrower than a part and the next part within that time, or a rate that spawns many
