@@ -12,6 +12,7 @@
 #include <string>
 
 #include "rheofeed/scene/mesh.hpp"
+#include "scene_builders.hpp"
 
 namespace rheofeed::scene {
 namespace {
@@ -255,14 +256,7 @@ Scene everyFieldScene() {
   bowl.law.calibrated_for->vibration.amplitude = 2.5e-4;  // calibrated for another amplitude
   s.fixtures.push_back(bowl);
 
-  Fixture ground;
-  ground.name = "ground";
-  Fixture::Geom plane;
-  plane.shape.kind = Shape::Kind::Plane;
-  plane.shape.plane_normal = {0, 0, 1};
-  plane.shape.plane_offset = -1;
-  ground.geoms.push_back(plane);
-  s.fixtures.push_back(ground);
+  s.fixtures.push_back(test::groundPlane("ground", -1));
 
   PartSpec boxes;
   boxes.name = "boxes";

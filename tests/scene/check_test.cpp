@@ -438,14 +438,7 @@ TEST(SceneCheck, ASpawnRegionOverNothingFires) {
   s.parts[0].spawn_min = {0.4, 0.4, 0.05};  // over the floor's corner: some land, no hazard
   EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnOverNothing).empty());
   s.parts[0].spawn_min = {0.8, 0.8, 0.05};
-  Fixture ground;  // a plane under everything
-  ground.name = "ground";
-  Fixture::Geom plane;
-  plane.shape.kind = Shape::Kind::Plane;
-  plane.shape.plane_normal = {0, 0, 1};
-  plane.shape.plane_offset = -1;
-  ground.geoms.push_back(plane);
-  s.fixtures.push_back(ground);
+  s.fixtures.push_back(test::groundPlane("ground", -1));  // a plane under everything
   EXPECT_TRUE(ofKind(checkScene(s, Method::OdeRheonomic), Hazard::Kind::SpawnOverNothing).empty());
 }
 

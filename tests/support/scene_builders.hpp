@@ -10,6 +10,18 @@
 
 namespace rheofeed::test {
 
+/// A static ground plane fixture named `name`: the half-space z <= height (m, world frame).
+inline scene::Fixture groundPlane(const std::string& name, double height) {
+  scene::Fixture ground;
+  ground.name = name;
+  scene::Fixture::Geom plane;
+  plane.shape.kind = scene::Shape::Kind::Plane;
+  plane.shape.plane_normal = {0, 0, 1};
+  plane.shape.plane_offset = height;
+  ground.geoms.push_back(plane);
+  return ground;
+}
+
 /// A static box fixture named `name` of edge lengths `size` (m), axis-aligned, whose top face
 /// is centred at `top_centre` (m, world frame): the box centre is top_centre - (0, 0, size.z / 2).
 inline scene::Fixture boxFixture(const std::string& name, const Vec3& size,
