@@ -265,7 +265,10 @@ int collect(const Folder& folder, const Manifest& manifest) {
       }
       for (const auto* records : {&answered[point], &no_answer[point]}) {
         for (const Record& r : *records) {
-          for (std::size_t k = 0; k < health; ++k) row.health[k] += r.health[mt][k];
+          for (std::size_t k = 0; k < health; ++k) {
+            // a count a record does not have (scene_check before it was recorded) adds nothing
+            if (std::isfinite(r.health[mt][k])) row.health[k] += r.health[mt][k];
+          }
         }
       }
       csv += std::to_string(point);

@@ -266,9 +266,22 @@ void prepareSweep(const Spec& spec, const Folder& folder) {
                                   folder.manifest().string() + " cannot be read (" + e.what() +
                                   "); use another --out");
     }
-    const Json& old_definition = old.contains("definition") ? old["definition"] : Json();
-    if (old_definition != definition) {
+    // Compared without max_lost_fraction, then that alone (in key order: an ordered_json
+    // compares its keys in order); a manifest written before the key had run's default.
+    Json old_definition = old.contains("definition") ? old["definition"] : Json();
+    Json old_fraction = scene::kDefaultMaxLostFraction;
+    if (old_definition.is_object() && old_definition.contains("max_lost_fraction")) {
+      old_fraction = old_definition["max_lost_fraction"];
+      old_definition.erase("max_lost_fraction");
+    }
+    Json new_definition = definition;
+    new_definition.erase("max_lost_fraction");
+    if (old_definition != new_definition || old_fraction != definition["max_lost_fraction"]) {
       std::string difference = "its methods, parameters or metrics differ";
+      if (old_definition == new_definition) {
+        difference = "its max_lost_fraction is " + old_fraction.dump() + ", this spec's " +
+                     definition["max_lost_fraction"].dump();
+      }
       if (old_definition.contains("jobs") && old_definition["jobs"] != definition["jobs"]) {
         const Json& a = old_definition["jobs"];
         const Json& b = definition["jobs"];

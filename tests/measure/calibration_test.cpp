@@ -151,6 +151,10 @@ TEST(StaleCalibration, AChangedVibrationGravityOrMuMakesTheCalibrationStaleNamin
   Scene shifted = calibrated;  // a phase does not change a steady drift
   shifted.fixtures[0].law.vibration.phase = 1;
   EXPECT_EQ(staleCalibration(shifted, 0), "");
+  Scene rounded = calibrated;  // the same values within rounding: no change
+  rounded.fixtures[0].law.vibration.amplitude *= 1 + 1e-12;
+  rounded.gravity.x = -0.0;
+  EXPECT_EQ(staleCalibration(rounded, 0), "");
   Scene local = louder;  // the local law uses no calibration
   local.fixtures[0].law.drift_model = DriftModel::Local;
   EXPECT_EQ(staleCalibration(local, 0), "");
@@ -173,6 +177,12 @@ TEST(StaleCalibration, LocalSampledEfficienciesKeepWhatTheyWereMeasuredFor) {
   c.efficiency = 0.8;
   const Scene sampled = withEfficiency(s, c);
   EXPECT_EQ(staleCalibration(sampled, 0), "");
+  // A calibrated drift kept beside the factors shares their record: one measured for this
+  // feeder stays, one of unknown origin (no calibrated_for) does not pass for it.
+  Scene drift_too = withCalibration(s, calibrateClassical(s, 0));
+  EXPECT_TRUE(withEfficiency(drift_too, c).fixtures[0].law.has_calibrated_drift);
+  drift_too.fixtures[0].law.calibrated_for.reset();
+  EXPECT_FALSE(withEfficiency(drift_too, c).fixtures[0].law.has_calibrated_drift);
   Scene faster = sampled;
   faster.fixtures[0].law.vibration.frequency = 60;
   const std::string why = staleCalibration(faster, 0);

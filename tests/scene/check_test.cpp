@@ -391,6 +391,16 @@ TEST(SceneCheck, AThrowBeyondNinetyDegreesIsAgainstTheConveyingDirection) {
   EXPECT_NE(h[0].message.find("172 degrees above outputs.conveying_direction"), std::string::npos)
       << h[0].message;
   EXPECT_EQ(toString(h[0].kind), std::string("against_conveying_direction"));
+  // direction and -direction are one motion: -20 degrees throws at 160, backwards; 200 at 20.
+  const std::vector<Hazard> below =
+      ofKind(checkScene(vibratingTrackScene(0.2e-3, 50, -20 * kPi / 180), Method::OdeRheonomic),
+             Hazard::Kind::AgainstConveyingDirection);
+  ASSERT_EQ(below.size(), 1u);
+  EXPECT_NE(below[0].message.find("160 degrees above"), std::string::npos) << below[0].message;
+  EXPECT_TRUE(
+      ofKind(checkScene(vibratingTrackScene(0.2e-3, 50, 200 * kPi / 180), Method::OdeRheonomic),
+             Hazard::Kind::AgainstConveyingDirection)
+          .empty());
   Scene backwards = slip;  // a feeder meant to run the other way says so
   backwards.outputs.conveying_direction = {-1, 0, 0};
   EXPECT_TRUE(

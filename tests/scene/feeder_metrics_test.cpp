@@ -321,6 +321,7 @@ TEST(FeederMetrics, FamiliesThatShareANameAreToldApartByTheirIndex) {
   // Unique already: unchanged; a name taken by an earlier suffixed one is suffixed too.
   EXPECT_EQ(uniqueNames({"a", "a[1]", "b"}), (std::vector<std::string>{"a", "a[1]", "b"}));
   EXPECT_EQ(uniqueNames({"a", "a", "a[1]"}), (std::vector<std::string>{"a", "a[1]", "a[1][2]"}));
+  EXPECT_EQ(uniqueNames({"a[2]", "a", "a"}), (std::vector<std::string>{"a[2]", "a", "a[2][2]"}));
 }
 
 // A library caller's run of a loaded scene names its file like `rheofeed run` does.

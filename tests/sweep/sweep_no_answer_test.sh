@@ -51,8 +51,21 @@ grep -q 'job 0001 (point 1, seed 1): ode_rheonomic lost 1 of 4 parts' "$work/swe
 "$bin" sweep "$work/spec.json" --out "$work/sweep" > "$work/again.log" 2>&1 ||
   fail "the sweep again exited with $?"
 grep -q '^local: 0 of 2 jobs to run' "$work/again.log" || fail "the sweep again runs a job"
+# A folder written before specs had max_lost_fraction (its manifest without the key) resumes.
+grep -q '"max_lost_fraction": 0.1' "$work/sweep/sweep.json" || fail "the manifest has no max_lost_fraction"
+sed -i '/"max_lost_fraction"/d' "$work/sweep/sweep.json"
+"$bin" sweep "$work/spec.json" --out "$work/sweep" > "$work/older.log" 2>&1 ||
+  fail "a folder of a manifest without max_lost_fraction is refused: $(cat "$work/older.log")"
+grep -q '^local: 0 of 2 jobs to run' "$work/older.log" || fail "the older folder's sweep runs a job"
+# The same folder with another bound is another sweep, and says which setting differs.
+# (the same spec file: the jobs' scenes name the spec they came from)
+sed -i 's/"seeds": 1,/"seeds": 1, "max_lost_fraction": 0.5,/' "$work/spec.json"
+! "$bin" sweep "$work/spec.json" --out "$work/sweep" > "$work/half.log" 2>&1 ||
+  fail "a folder of another max_lost_fraction is resumed"
+grep -q 'its max_lost_fraction is 0.1, this spec.s 0.5' "$work/half.log" ||
+  fail "the refusal does not name max_lost_fraction: $(cat "$work/half.log")"
 # A spec that allows a quarter of the parts lost (a feeder with a reject slot): both jobs ok.
-sed 's/"seeds": 1,/"seeds": 1, "max_lost_fraction": 0.25,/' "$work/spec.json" > "$work/spec_quarter.json"
+sed 's/"max_lost_fraction": 0.5,/"max_lost_fraction": 0.25,/' "$work/spec.json" > "$work/spec_quarter.json"
 "$bin" sweep "$work/spec_quarter.json" --out "$work/quarter" > "$work/quarter.log" 2>&1 ||
   fail "the sweep with max_lost_fraction 0.25 exited with $?: $(cat "$work/quarter.log")"
 grep -q '"status": "ok"' "$work/quarter/records/0001.json" ||

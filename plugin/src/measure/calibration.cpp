@@ -261,6 +261,16 @@ Scene withEfficiency(Scene scene, const EfficiencyCalibration& calibration) {
                                 std::to_string(calibration.family));
   }
   FeederLaw& law = scene.fixtures[static_cast<std::size_t>(calibration.fixture)].law;
+  // A calibrated drift kept beside the factors shares their calibrated_for: it stays only if it
+  // was measured for this same feeder, else the new record would vouch for it.
+  if (law.has_calibrated_drift) {
+    Scene as_drift = scene;
+    as_drift.fixtures[static_cast<std::size_t>(calibration.fixture)].law.drift_model =
+        DriftModel::CalibratedDrift;
+    if (!law.calibrated_for || !staleCalibration(as_drift, calibration.fixture).empty()) {
+      law.has_calibrated_drift = false;
+    }
+  }
   law.drift_model = DriftModel::LocalSampled;
   if (law.efficiency.size() != scene.parts.size()) law.efficiency.assign(scene.parts.size(), 1.0);
   law.efficiency[static_cast<std::size_t>(calibration.family)] = calibration.efficiency;

@@ -583,30 +583,39 @@ std::string staleCalibration(const Scene& scene, int fixture) {
   const CalibrationBasis& was = *law.calibrated_for;
   const Vibration& v = law.vibration;
   std::string changed;
-  const auto compare = [&](const char* what, const std::string& then, const std::string& now) {
-    if (then == now) return;
+  // Equal within rounding (1e-9 relative, 1e-12 absolute: a hand-written angle_deg 90 against
+  // [0, 0, 1], -0 against 0) is no change; an edit of the scene is.
+  const auto close = [](double x, double y) {
+    return std::abs(x - y) <= 1e-9 * std::max(std::abs(x), std::abs(y)) + 1e-12;
+  };
+  const auto note = [&](const char* what, const std::string& then, const std::string& now) {
     changed += (changed.empty() ? "" : ", ") + std::string(what) + " " + then +
                " when calibrated, " + now + " now";
   };
-  const auto vec = [](const Vec3& a) {
-    return "[" + formatNumber(a.x) + ", " + formatNumber(a.y) + ", " + formatNumber(a.z) + "]";
+  const auto number = [&](const char* what, double then, double now) {
+    if (!close(then, now)) note(what, formatNumber(then), formatNumber(now));
   };
-  // Compared as printed, to 6 significant digits: a round trip's last-digit noise is no change,
-  // an edit of the scene is.
-  compare("amplitude (m)", formatNumber(was.vibration.amplitude), formatNumber(v.amplitude));
-  compare("frequency (Hz)", formatNumber(was.vibration.frequency), formatNumber(v.frequency));
+  const auto vector = [&](const char* what, const Vec3& then, const Vec3& now) {
+    const auto text = [](const Vec3& x) {
+      return "[" + formatNumber(x.x) + ", " + formatNumber(x.y) + ", " + formatNumber(x.z) + "]";
+    };
+    if (!close(then.x, now.x) || !close(then.y, now.y) || !close(then.z, now.z)) {
+      note(what, text(then), text(now));
+    }
+  };
+  number("amplitude (m)", was.vibration.amplitude, v.amplitude);
+  number("frequency (Hz)", was.vibration.frequency, v.frequency);
   // A direction without a translation, an axis without a torsion, moves nothing.
   if (was.vibration.amplitude != 0 || v.amplitude != 0) {
-    compare("direction", vec(was.vibration.direction), vec(v.direction));
+    vector("direction", was.vibration.direction, v.direction);
   }
-  compare("torsion amplitude (rad)", formatNumber(was.vibration.torsion_amplitude),
-          formatNumber(v.torsion_amplitude));
+  number("torsion amplitude (rad)", was.vibration.torsion_amplitude, v.torsion_amplitude);
   if (was.vibration.torsion_amplitude != 0 || v.torsion_amplitude != 0) {
-    compare("axis origin (m)", vec(was.vibration.axis_origin), vec(v.axis_origin));
-    compare("axis direction", vec(was.vibration.axis_direction), vec(v.axis_direction));
+    vector("axis origin (m)", was.vibration.axis_origin, v.axis_origin);
+    vector("axis direction", was.vibration.axis_direction, v.axis_direction);
   }
-  compare("gravity (m/s^2)", vec(was.gravity), vec(scene.gravity));
-  compare("mu", formatNumber(was.mu), formatNumber(scene.material.mu));
+  vector("gravity (m/s^2)", was.gravity, scene.gravity);
+  number("mu", was.mu, scene.material.mu);
   if (changed.empty()) return "";
   return std::string("its ") +
          (law.drift_model == DriftModel::CalibratedDrift ? "calibrated drift was"
@@ -646,10 +655,8 @@ std::vector<std::string> uniqueNames(const std::vector<std::string>& names) {
   std::set<std::string> seen;
   for (std::size_t k = 0; k < names.size(); ++k) {
     std::string key = names[k];
-    if (!seen.insert(key).second) {
-      key += "[" + std::to_string(k) + "]";
-      seen.insert(key);
-    }
+    // taken (by an earlier name, or by a suffixed one): suffix the index, again while taken
+    while (!seen.insert(key).second) key += "[" + std::to_string(k) + "]";
     keys.push_back(key);
   }
   return keys;

@@ -318,9 +318,11 @@ void checkConveyingSense(const CheckContext& c, std::vector<Hazard>& out) {
     if (law.kind != FeederLaw::Kind::Vibration) continue;
     const Vibration& v = law.vibration;
     if (v.torsion_amplitude != 0 || v.amplitude == 0) continue;
-    // Parts hop along the vibration's horizontal part (NOTES section 5: a throw angle above
-    // the track). Straight up or nearly: no sense to judge.
-    const Vec3 across = v.direction - dot(v.direction, c.up) * c.up;
+    // Parts hop along the horizontal part of the throw (NOTES section 5: a throw angle above
+    // the track): of +-direction (one motion, half a cycle apart) the one that points up.
+    // Straight up or nearly: no sense to judge.
+    const Vec3 throw_dir = dot(v.direction, c.up) < 0 ? -1.0 * v.direction : v.direction;
+    const Vec3 across = throw_dir - dot(throw_dir, c.up) * c.up;
     const double n = norm(across), nd = norm(d);
     if (!(n > 1e-3) || !(nd > 0)) continue;
     const double cosine = dot(across, d) / (n * nd);
@@ -330,7 +332,7 @@ void checkConveyingSense(const CheckContext& c, std::vector<Hazard>& out) {
     hz.value = cosine;
     hz.limit = 0;
     hz.where = idx("fixtures", f) + ".law.vibration.direction, outputs.conveying_direction";
-    const double above = std::atan2(dot(v.direction, c.up), dot(v.direction, (1.0 / nd) * d));
+    const double above = std::atan2(dot(throw_dir, c.up), dot(throw_dir, (1.0 / nd) * d));
     hz.message = "fixture '" + c.scene.fixtures[f].name + "' vibrates " + fmt(above * 180 / kPi) +
                  " degrees above outputs.conveying_direction, beyond 90: its horizontal part "
                  "points against it (cosine " +

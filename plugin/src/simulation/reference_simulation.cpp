@@ -91,19 +91,19 @@ class ReferenceSimulation final : public PartSimulation {
     a.bounce_velocity = s.bounce_velocity;
   }
 
-  // What one step's contact solve may run in the applied mode; its iteration count sums all of
-  // it (ccp/solver.cpp: the fixed point's rounds and normal re-solves; world_contacts.cpp: the
-  // interior-point rounds after NSGS).
+  // What one step's contact solve may run in the applied mode, and what its iteration count
+  // counts (ccp/solver.cpp: the fixed point sums its rounds and normal re-solves;
+  // world_contacts.cpp: after the interior-point rounds the best single solve is kept).
   std::string solveBudget() const {
     const std::string n = std::to_string(applied_.iterations.value_or(0));
     if (applied_.mode == "coulomb_fixed_point") {
       return std::to_string(applied_.coulomb_iterations.value_or(0)) + " rounds of at most " + n +
              " iterations each, then normal re-solves (the count sums them all)";
     }
-    if (applied_.mode == "coulomb_nsgs") {
-      return "at most " + n + " sweeps, then up to " +
+    if (applied_.mode == "coulomb_nsgs") {  // the count is the kept solve's own
+      return "at most " + n + " sweeps, then, while unconverged and where they can run, up to " +
              std::to_string(applied_.ipm_rounds.value_or(0)) +
-             " interior-point and NSGS rounds while unconverged (the count sums them all)";
+             " interior-point and NSGS rounds (the count is the best of them)";
     }
     return "at most " + n + " iterations";
   }

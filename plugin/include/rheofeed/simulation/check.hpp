@@ -43,8 +43,9 @@ struct Hazard {
     /// the peak acceleration (m/s^2): A w^2 for the translation, theta w^2 r for the torsion at
     /// the fixture's farthest point r from the axis, combined as perpendicular; limit: the bound.
     ExtremeVibration,
-    /// A translating vibration (no torsion; the drift measured along a direction) whose
-    /// horizontal part points against Outputs::conveying_direction: the parts drift backwards,
+    /// A translating vibration (no torsion; the drift measured along a direction) whose throw
+    /// (of +-direction, the one pointing up) has a horizontal part against
+    /// Outputs::conveying_direction: the parts drift backwards,
     /// away from the exit; most often a throw angle beyond 90 degrees ("angle_rad": 3 meant in
     /// degrees). value: the cosine between the two; limit: 0.
     AgainstConveyingDirection,
