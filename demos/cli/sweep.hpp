@@ -157,6 +157,10 @@ struct Record {
   std::vector<std::vector<std::optional<double>>> metrics;
   /// health[method]: parts lost, solver trouble and ignored settings (summed in the CSV).
   std::vector<std::vector<double>> health;
+  /// trusted[method]: that method's run has an answer (its JSON's answer.trusted): all of an ok
+  /// job's; a no_answer job's as recorded (a job has no answer when one of its methods has
+  /// none; the others' still count), none where not recorded.
+  std::vector<bool> trusted;
   double cpu_seconds = 0;
 };
 

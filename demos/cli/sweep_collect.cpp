@@ -224,14 +224,20 @@ int collect(const Folder& folder, const Manifest& manifest) {
     for (std::size_t mt = 0; mt < methods; ++mt) {
       jobs_csv += id + "," + std::to_string(job.point) + "," + std::to_string(job.seed);
       for (double v : job.values) jobs_csv += "," + num(v);
-      jobs_csv += "," + manifest.methods[mt] + "," + status + "," + (r ? num(r->cpu_seconds) : "");
+      // a job with no answer: per method, the ones whose runs have one are ok
+      const bool answers = r && status == "no_answer" && r->trusted[mt];
+      jobs_csv += "," + manifest.methods[mt] + "," + (answers ? "ok" : status) + "," +
+                  (r ? num(r->cpu_seconds) : "");
       for (std::size_t k = 0; k < metrics; ++k) {
         jobs_csv += "," + (r && r->metrics[mt][k] ? num(*r->metrics[mt][k]) : std::string());
       }
       for (std::size_t k = 0; k < health; ++k) {
         jobs_csv += "," + (r && finished(*r) ? num(r->health[mt][k]) : std::string());
       }
-      std::string e = !r ? error : r->status == "no_answer" ? r->no_answer : r->error;
+      std::string e = !r                         ? error
+                      : answers                  ? ""
+                      : r->status == "no_answer" ? r->no_answer
+                                                 : r->error;
       std::replace(e.begin(), e.end(), '"', '\'');
       jobs_csv += ",\"" + e + "\"\n";
     }
@@ -251,15 +257,28 @@ int collect(const Folder& folder, const Manifest& manifest) {
       Row row;
       row.point = point;
       row.values = values;
-      row.ok = static_cast<int>(answered[point].size());
       row.failed = unfinished[point].first;
       row.missing = unfinished[point].second;
-      row.no_answer = static_cast<int>(no_answer[point].size());
+      // Per method: a job without an answer (one of its methods has none) still answers for
+      // the methods whose runs have one.
+      std::vector<const Record*> trusted;
+      for (const auto* records : {&answered[point], &no_answer[point]}) {
+        for (const Record& r : *records) {
+          if (r.trusted[mt]) {
+            trusted.push_back(&r);
+          } else {
+            ++row.no_answer;
+          }
+        }
+      }
+      row.ok = static_cast<int>(trusted.size());
       row.health.assign(health, 0.0);
       for (std::size_t k = 0; k < metrics; ++k) {
         std::vector<double> v;
-        for (const Record& r : answered[point]) {
-          if (r.metrics[mt][k] && std::isfinite(*r.metrics[mt][k])) v.push_back(*r.metrics[mt][k]);
+        for (const Record* r : trusted) {
+          if (r->metrics[mt][k] && std::isfinite(*r->metrics[mt][k])) {
+            v.push_back(*r->metrics[mt][k]);
+          }
         }
         row.metrics.push_back(stats(v));
       }

@@ -440,6 +440,10 @@ std::optional<Record> readRecord(const Folder& folder, const Manifest& manifest,
       }
       r.metrics.push_back(values);
       r.health.push_back(health);
+      const bool recorded = j.contains("trusted") && j["trusted"].contains(method) &&
+                            j["trusted"][method].is_boolean();
+      r.trusted.push_back(r.status == "ok" || (r.status == "no_answer" && recorded &&
+                                               j["trusted"][method].get<bool>()));
     }
     return r;
   } catch (const std::exception& e) {
@@ -725,6 +729,9 @@ int runJob(const Folder& folder, const Manifest& manifest, const std::string& id
         }
       }
       record["metrics"][method] = values;
+      if (run.contains("answer") && run["answer"].contains("trusted")) {
+        record["trusted"][method] = run["answer"]["trusted"];
+      }
       record["health"][method] = run.contains("health") ? run["health"] : Json();
       // The scene check's hazards of the run (a unit slip warns there): counted in sweep.csv.
       if (run.contains("scene_check")) record["health"][method]["scene_check"] = run["scene_check"];

@@ -34,6 +34,9 @@ grep -q '"no_answer": "ode_rheonomic lost 1 of 4 parts (25 %), more than max_los
 grep -q '"parts_lost": 1' "$record" || fail "job 0001's health is not recorded"
 grep -q '"mean_drift_mps": [0-9]' "$record" || fail "job 0001's run measured no mean drift (the test needs one to leave out)"
 grep -q '"trusted": 0' "$record" || fail "job 0001's metric /answer/trusted is not 0"
+# the verdict per method (a job with several methods answers for those whose runs have one)
+grep -A1 '^  "trusted": {' "$record" | grep -q '"ode_rheonomic": false' ||
+  fail "job 0001 does not record ode_rheonomic's verdict, untrusted"
 csv="$work/sweep/results/sweep.csv"
 head -1 "$csv" | grep -q '^point,removal_height_m,method,seeds_ok,seeds_failed,seeds_missing,seeds_no_answer,mean_drift_mps_mean,' ||
   fail "sweep.csv has no seeds_no_answer column: $(head -1 "$csv")"
