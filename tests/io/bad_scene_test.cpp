@@ -292,6 +292,15 @@ TEST(SceneLimits, AngleBeyondAMillionDegreesIsRefusedWithItsRange) {
       replaced(kGood, R"("angle_deg": 20)", R"("angle_deg": 20, "phase_deg": 1e6)"), "ok"));
 }
 
+// A torsion beyond half a turn is named in the unit it was given in.
+TEST(SceneLimits, TorsionBeyondHalfATurnIsRefusedInItsOwnUnit) {
+  refused(replaced(kGood, R"("angle_deg": 20)", R"("angle_deg": 20, "torsion_amplitude_deg": 400)"),
+          "fixtures[0].law.vibration.torsion_amplitude_deg",
+          {"at most half a turn, 180 degrees or pi rad, got 400 degrees"});
+  refused(replaced(kGood, R"("angle_deg": 20)", R"("angle_deg": 20, "torsion_amplitude_rad": 4)"),
+          "fixtures[0].law.vibration.torsion_amplitude_rad", {"got 4 rad"});
+}
+
 TEST(SceneLimits, GeomRotationAngleBeyondTheRangeIsRefused) {
   refused(
       replaced(kGood, R"("position": [0, 1, -0.01]})",

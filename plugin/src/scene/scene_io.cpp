@@ -293,6 +293,19 @@ Shape::Kind shapeKind(const json& v, const std::string& path) {
        "unknown shape \"" + name + "\"; expected box, sphere, cylinder, capsule, plane or mesh");
 }
 
+// A torsion amplitude, refused beyond half a turn in the unit it was given in (the scene's limit,
+// limits::kMaxTorsion: "torsion_amplitude_deg": 400 is named as 400 degrees, not 6.98 rad).
+void readTorsion(Object& o, Vibration& v) {
+  if (!o.optAngle("torsion_amplitude", v.torsion_amplitude, Range::NonNegative)) return;
+  if (v.torsion_amplitude > limits::kMaxTorsion) {
+    const bool deg = o.has("torsion_amplitude_deg");
+    fail(o.at(deg ? "torsion_amplitude_deg" : "torsion_amplitude_rad"),
+         "a torsion amplitude must be at most half a turn, 180 degrees or pi rad, got " +
+             show(deg ? v.torsion_amplitude * 180 / kPi : v.torsion_amplitude) +
+             (deg ? " degrees" : " rad") + " (vibratory bowls turn by a fraction of a degree)");
+  }
+}
+
 void readVibration(Object& o, Vibration& v) {
   o.opt("amplitude", v.amplitude, Range::NonNegative);
   o.req("frequency", v.frequency, Range::Positive);
@@ -312,7 +325,7 @@ void readVibration(Object& o, Vibration& v) {
     o.opt("direction", v.direction, UnitVector{});
   }
   o.optAngle("phase", v.phase);
-  o.optAngle("torsion_amplitude", v.torsion_amplitude, Range::NonNegative);
+  readTorsion(o, v);
   o.opt("axis_origin", v.axis_origin);
   o.opt("axis_direction", v.axis_direction, UnitVector{});
 }
@@ -320,7 +333,7 @@ void readVibration(Object& o, Vibration& v) {
 // A bowl's screw motion: translation along the torsion axis in phase with the torsion.
 void readScrew(Object& o, Vibration& v) {
   o.opt("vertical_amplitude", v.amplitude, Range::NonNegative);
-  o.optAngle("torsion_amplitude", v.torsion_amplitude, Range::NonNegative);
+  readTorsion(o, v);
   o.req("frequency", v.frequency, Range::Positive);
   o.optAngle("phase", v.phase);
   o.opt("axis_origin", v.axis_origin);
