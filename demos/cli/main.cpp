@@ -82,18 +82,22 @@ void addSceneArgs(CLI::App* sub, SceneArgs& a, bool with_methods, bool with_over
       ->each([&a](const std::string&) { a.seed_given = true; });
 }
 
+// The whole of `text` as a number; nan when it is not one (trailing characters included).
+double wholeNumber(const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(text, &used);
+    return used == text.size() ? v : std::nan("");
+  } catch (const std::exception&) {
+    return std::nan("");
+  }
+}
+
 // CLI11 check: a finite number of vibration cycles, >= 0 (or > 0 when `positive`).
 CLI::Validator cyclesCheck(const char* option, bool positive) {
   return CLI::Validator(
       [positive](std::string& text) {
-        double v = 0;
-        try {
-          std::size_t used = 0;
-          v = std::stod(text, &used);
-          if (used != text.size()) v = std::nan("");
-        } catch (const std::exception&) {
-          v = std::nan("");
-        }
+        const double v = wholeNumber(text);
         if (std::isfinite(v) && (positive ? v > 0 : v >= 0) && v <= 1e6) return std::string();
         return "got " + text + ": must be a finite number of vibration cycles " +
                (positive ? "> 0" : ">= 0") + " and at most 1e6";
@@ -105,14 +109,7 @@ CLI::Validator cyclesCheck(const char* option, bool positive) {
 CLI::Validator fractionCheck() {
   return CLI::Validator(
       [](std::string& text) {
-        double v = 0;
-        try {
-          std::size_t used = 0;
-          v = std::stod(text, &used);
-          if (used != text.size()) v = std::nan("");
-        } catch (const std::exception&) {
-          v = std::nan("");
-        }
+        const double v = wholeNumber(text);
         if (v >= 0 && v <= 1) return std::string();
         return "got " + text +
                ": must be a number in [0, 1] (the share of the parts it spawned a run may lose "
