@@ -141,6 +141,15 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
                                      c.efficiency, c.ci95, options));
         sampled = withEfficiency(sampled, c);
       }
+      if (law.has_calibrated_drift && !sampled.fixtures[i].law.has_calibrated_drift) {
+        // withEfficiency: one calibrated_for serves both; a drift not known to fit this
+        // feeder would pass for one
+        std::fprintf(log,
+                     "%s: fixture '%s': its calibrated drift is dropped: it was not recorded as "
+                     "measured for this vibration, gravity and mu (calibrated_for), which the "
+                     "efficiency factors now record\n",
+                     label.c_str(), name.c_str());
+      }
       scene = sampled;
     }
     std::fprintf(log, "%s: %s\n", label.c_str(), line.str().c_str());
