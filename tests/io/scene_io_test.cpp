@@ -122,6 +122,19 @@ void expectSameScene(const Scene& a, const Scene& b) {
                  w + ".calibrated_for.gravity");
       EXPECT_EQ(la.calibrated_for->mu, lb.calibrated_for->mu) << w;
       EXPECT_EQ(la.calibrated_for->method, lb.calibrated_for->method) << w;
+      const CalibrationBasis &ba = *la.calibrated_for, &bb = *lb.calibrated_for;
+      ASSERT_EQ(ba.conveying_direction.has_value(), bb.conveying_direction.has_value()) << w;
+      if (ba.conveying_direction) {
+        expectSame(*ba.conveying_direction, *bb.conveying_direction,
+                   w + ".calibrated_for.conveying_direction");
+      }
+      ASSERT_EQ(ba.track_point.has_value(), bb.track_point.has_value()) << w;
+      if (ba.track_point) {
+        expectSame(*ba.track_point, *bb.track_point, w + ".calibrated_for.track_point");
+      }
+      EXPECT_EQ(ba.restitution, bb.restitution) << w;
+      EXPECT_EQ(ba.parts_digest, bb.parts_digest) << w;
+      EXPECT_EQ(ba.fixtures_digest, bb.fixtures_digest) << w;
     }
     EXPECT_EQ(la.has_calibrated_drift, lb.has_calibrated_drift) << w;
     expectSame(la.calibrated_drift, lb.calibrated_drift, w + ".calibrated_drift");
@@ -252,7 +265,16 @@ Scene everyFieldScene() {
   bowl.law.calibrated_drift = {{0, 0, 0.0019}, {0, 0, 0.4}, {-3, 0, 0}};
   bowl.law.drift_model = DriftModel::LocalSampled;            // the calibrated drift kept beside it
   bowl.law.efficiency = {0.8123456789012345, 1, 1.0 / 3, 0};  // boxes, balls, pins, nuts
-  bowl.law.calibrated_for = CalibrationBasis{v, {0.1, 0, -9.7}, 0.45, "sampling"};
+  CalibrationBasis& basis = bowl.law.calibrated_for.emplace();
+  basis.vibration = v;
+  basis.gravity = {0.1, 0, -9.7};
+  basis.mu = 0.45;
+  basis.method = "sampling";
+  basis.conveying_direction = Vec3{0.6, 0.8, 0};
+  basis.track_point = Vec3{-2.86, 0.125, 0.0421};
+  basis.restitution = 0.15;
+  basis.parts_digest = "0123456789abcdef";
+  basis.fixtures_digest = "fedcba9876543210";
   bowl.law.calibrated_for->vibration.amplitude = 2.5e-4;  // calibrated for another amplitude
   s.fixtures.push_back(bowl);
 
@@ -334,6 +356,12 @@ TEST(SceneFile, RoundTripKeepsEveryField) {
   EXPECT_EQ(meshes.calls, 2);     // bowl (scale 0.001) and nut (scale 1), each once
   ASSERT_TRUE(back.fixtures[2].geoms[0].shape.mesh_data);
   ASSERT_TRUE(back.parts[3].mesh_data);
+  // What a sampling calibration records of the parts and fixtures (their digests, taken from
+  // the loaded meshes and the rotations computed from angles) reads back the same.
+  const Scene again = parseScene(toJson(back), "again.json", meshes.loader());
+  EXPECT_EQ(partsDigest(again), partsDigest(back));
+  EXPECT_EQ(fixturesDigest(again), fixturesDigest(back));
+  EXPECT_EQ(partsDigest(back).size(), 16u);
 }
 
 TEST(SceneFile, PartMeshIsCentredOnItsCentreOfMass) {
@@ -631,6 +659,19 @@ TEST(SceneFileErrors, OutOfRangeValuesNameThePath) {
   refused(replaced(kGood, R"("position": [0, 0, -0.01])",
                    R"("rotation": {"axis": [0, 0, 0], "angle_deg": 5})"),
           "fixtures[0].geoms[0].rotation.axis", "zero vector");
+  const std::string basis =
+      R"("angle_deg": 20}, "calibrated_drift": {"linear": [0.02, 0, 0]},
+         "calibrated_for": {"vibration": {"amplitude": 2e-4, "frequency": 50, "angle_deg": 20},
+                            "gravity": [0, 0, -9.81], "mu": 0.5, )";
+  refused(replaced(kGood, R"("angle_deg": 20})", basis + R"("parts_digest": "12ab"})"),
+          "fixtures[0].law.calibrated_for.parts_digest", "expected 16 lowercase hex digits");
+  refused(
+      replaced(kGood, R"("angle_deg": 20})", basis + R"("fixtures_digest": "0123456789ABCDEF"})"),
+      "fixtures[0].law.calibrated_for.fixtures_digest", "got \"0123456789ABCDEF\"");
+  refused(replaced(kGood, R"("angle_deg": 20})", basis + R"("restitution": 1.5})"),
+          "fixtures[0].law.calibrated_for.restitution", "must be in [0, 1]");
+  refused(replaced(kGood, R"("angle_deg": 20})", basis + R"("conveying_direction": [0, 0, 0]})"),
+          "fixtures[0].law.calibrated_for.conveying_direction", "zero vector");
 }
 
 TEST(SceneFileErrors, OverflowingNumberIsRefusedAsNotFinite) {

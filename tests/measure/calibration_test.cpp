@@ -192,6 +192,117 @@ TEST(StaleCalibration, LocalSampledEfficienciesKeepWhatTheyWereMeasuredFor) {
       << why;
 }
 
+// A sample run measures the drift of the scene's parts on its fixtures: other parts (a sweep
+// over their size), moved fixtures or another restitution make it stale too; more or fewer of
+// the same parts, or a new family name, do not.
+TEST(StaleCalibration, ASampledCalibrationKnowsItsPartsFixturesAndRestitution) {
+  const Scene s = hoppingTrack();
+  Calibration c = calibrateClassical(s, 0);
+  c.method = "sampling";  // as calibrateBySampling returns it (the value itself is not used)
+  const Scene calibrated = withCalibration(s, c);
+  const CalibrationBasis& basis = *calibrated.fixtures[0].law.calibrated_for;
+  EXPECT_EQ(basis.parts_digest, partsDigest(s));
+  EXPECT_EQ(basis.fixtures_digest, fixturesDigest(s));
+  EXPECT_EQ(basis.restitution, s.material.restitution);
+  ASSERT_TRUE(basis.conveying_direction.has_value());
+  EXPECT_FALSE(basis.track_point.has_value());  // a straight track: no radius
+  EXPECT_EQ(staleCalibration(calibrated, 0), "");
+
+  Scene more = calibrated;  // more of the same parts, later, under another name
+  more.parts[0].count *= 10;
+  more.parts[0].rate = 5;
+  more.parts[0].name = "renamed";
+  EXPECT_EQ(staleCalibration(more, 0), "");
+  Scene rounded = calibrated;
+  rounded.parts[0].size[0].mean *= 1 + 1e-13;
+  rounded.fixtures[0].geoms[0].pose.position.x += 1e-14;
+  EXPECT_EQ(staleCalibration(rounded, 0), "");
+
+  Scene bigger = calibrated;
+  bigger.parts[0].size[0].mean *= 1.5;
+  const std::string why = staleCalibration(bigger, 0);
+  EXPECT_EQ(why.find("its calibrated drift was measured with other parts: the parts (digest"), 0u)
+      << why;
+  EXPECT_NE(why.find(basis.parts_digest + " when calibrated, " + partsDigest(bigger) + " now"),
+            std::string::npos)
+      << why;
+  EXPECT_TRUE(needsCalibration(bigger));
+  EXPECT_THROW(rheonomicLaw(bigger, 0), std::invalid_argument);
+  Scene denser = calibrated;
+  denser.parts[0].density *= 2;
+  EXPECT_NE(staleCalibration(denser, 0), "");
+  Scene bouncier = calibrated;
+  bouncier.material.restitution = 0.5;
+  EXPECT_NE(staleCalibration(bouncier, 0).find("restitution 0 when calibrated, 0.5 now"),
+            std::string::npos)
+      << staleCalibration(bouncier, 0);
+
+  Scene raised = calibrated;
+  raised.fixtures[0].geoms[0].pose.position.z += 0.01;
+  const std::string moved = staleCalibration(raised, 0);
+  EXPECT_EQ(moved.find("its calibrated drift was measured for another feeder: the fixtures' "
+                       "geometry (digest) " +
+                       basis.fixtures_digest + " when calibrated"),
+            0u)
+      << moved;
+  raised.parts[0].density *= 2;
+  EXPECT_EQ(staleCalibration(raised, 0).find("its calibrated drift was measured for another "
+                                             "feeder and parts: the fixtures' geometry"),
+            0u)
+      << staleCalibration(raised, 0);
+  Scene turned = calibrated;  // the drift is measured along the conveying direction
+  turned.outputs.conveying_direction = {0, 1, 0};
+  EXPECT_NE(staleCalibration(turned, 0).find("conveying direction [1, 0, 0] when calibrated, "
+                                             "[0, 1, 0] now"),
+            std::string::npos)
+      << staleCalibration(turned, 0);
+}
+
+// The classical model takes the vibration, gravity, mu, a straight track's direction and a
+// screw's radius (the spawn centre's), not the parts or the fixtures' shapes.
+TEST(StaleCalibration, AClassicalCalibrationKnowsItsTrackDirectionAndAScrewsRadius) {
+  const Scene s = hoppingTrack();
+  const Scene calibrated = withCalibration(s, calibrateClassical(s, 0));
+  const CalibrationBasis& basis = *calibrated.fixtures[0].law.calibrated_for;
+  EXPECT_TRUE(basis.parts_digest.empty());
+  EXPECT_FALSE(basis.restitution.has_value());
+  Scene other_parts = calibrated;
+  other_parts.parts[0].size[0].mean *= 2;
+  other_parts.parts[0].spawn_min.x += 0.1;
+  other_parts.parts[0].spawn_max.x += 0.1;
+  other_parts.fixtures[0].geoms[0].pose.position.z += 0.01;
+  EXPECT_EQ(staleCalibration(other_parts, 0), "");
+  Scene turned = calibrated;
+  turned.outputs.conveying_direction = {0, -1, 0};
+  EXPECT_NE(staleCalibration(turned, 0).find("conveying direction"), std::string::npos);
+
+  Scene screw = s;
+  Vibration& v = screw.fixtures[0].law.vibration;
+  v.torsion_amplitude = 0.003;
+  v.axis_origin = {0, -0.5, 0};
+  v.axis_direction = {0, 0, 1};
+  Calibration twist;
+  twist.fixture = 0;
+  twist.method = "classical";
+  twist.drift.angular = {0, 0, 0.3};
+  twist.drift.origin = v.axis_origin;
+  const Scene bowl = withCalibration(screw, twist);
+  const CalibrationBasis& screw_basis = *bowl.fixtures[0].law.calibrated_for;
+  ASSERT_TRUE(screw_basis.track_point.has_value());
+  EXPECT_FALSE(screw_basis.conveying_direction.has_value());  // a screw's drift turns
+  EXPECT_EQ(staleCalibration(bowl, 0), "");
+  Scene spun = bowl;
+  spun.outputs.conveying_direction = {0, 1, 0};
+  EXPECT_EQ(staleCalibration(spun, 0), "");
+  Scene wider = bowl;  // the spawn region further from the axis: another radius
+  wider.parts[0].spawn_min.y -= 0.2;
+  wider.parts[0].spawn_max.y -= 0.2;
+  EXPECT_NE(staleCalibration(wider, 0).find("track point (m, the first part family's spawn "
+                                            "centre)"),
+            std::string::npos)
+      << staleCalibration(wider, 0);
+}
+
 TEST(CalibrateScene, CalibratesAStaleCalibrationAgainAndSaysWhy) {
   Scene s = hoppingTrack();
   s.fixtures[0].law.drift_model = DriftModel::CalibratedDrift;

@@ -162,8 +162,7 @@ Scene withCalibration(Scene scene, const Calibration& calibration) {
   law.calibrated_drift = calibration.drift;
   law.drift_model = DriftModel::CalibratedDrift;
   law.efficiency.clear();
-  law.calibrated_for =
-      CalibrationBasis{law.vibration, scene.gravity, scene.material.mu, calibration.method};
+  law.calibrated_for = calibrationBasis(scene, calibration.fixture, calibration.method);
   return scene;
 }
 
@@ -274,8 +273,7 @@ Scene withEfficiency(Scene scene, const EfficiencyCalibration& calibration) {
   law.drift_model = DriftModel::LocalSampled;
   if (law.efficiency.size() != scene.parts.size()) law.efficiency.assign(scene.parts.size(), 1.0);
   law.efficiency[static_cast<std::size_t>(calibration.family)] = calibration.efficiency;
-  law.calibrated_for =
-      CalibrationBasis{law.vibration, scene.gravity, scene.material.mu, "sampling"};
+  law.calibrated_for = calibrationBasis(scene, calibration.fixture, "sampling");
   return scene;
 }
 

@@ -574,60 +574,6 @@ bool lacksCalibration(const FeederLaw& law) {
   return false;
 }
 
-std::string staleCalibration(const Scene& scene, int fixture) {
-  const FeederLaw& law = scene.fixtures.at(static_cast<std::size_t>(fixture)).law;
-  if (law.kind != FeederLaw::Kind::Vibration || law.drift_model == DriftModel::Local ||
-      lacksCalibration(law) || !law.calibrated_for) {
-    return "";
-  }
-  const CalibrationBasis& was = *law.calibrated_for;
-  const Vibration& v = law.vibration;
-  std::string changed;
-  // Equal within rounding (1e-9 relative, 1e-12 absolute: a hand-written angle_deg 90 against
-  // [0, 0, 1], -0 against 0) is no change; an edit of the scene is.
-  const auto close = [](double x, double y) {
-    return std::abs(x - y) <= 1e-9 * std::max(std::abs(x), std::abs(y)) + 1e-12;
-  };
-  const auto note = [&](const char* what, const std::string& then, const std::string& now) {
-    changed += (changed.empty() ? "" : ", ") + std::string(what) + " " + then +
-               " when calibrated, " + now + " now";
-  };
-  const auto number = [&](const char* what, double then, double now) {
-    if (!close(then, now)) note(what, formatNumber(then), formatNumber(now));
-  };
-  const auto vector = [&](const char* what, const Vec3& then, const Vec3& now) {
-    const auto text = [](const Vec3& x) {
-      return "[" + formatNumber(x.x) + ", " + formatNumber(x.y) + ", " + formatNumber(x.z) + "]";
-    };
-    if (!close(then.x, now.x) || !close(then.y, now.y) || !close(then.z, now.z)) {
-      note(what, text(then), text(now));
-    }
-  };
-  number("amplitude (m)", was.vibration.amplitude, v.amplitude);
-  number("frequency (Hz)", was.vibration.frequency, v.frequency);
-  // A direction without a translation, an axis without a torsion, moves nothing.
-  if (was.vibration.amplitude != 0 || v.amplitude != 0) {
-    vector("direction", was.vibration.direction, v.direction);
-  }
-  number("torsion amplitude (rad)", was.vibration.torsion_amplitude, v.torsion_amplitude);
-  if (was.vibration.torsion_amplitude != 0 || v.torsion_amplitude != 0) {
-    vector("axis origin (m)", was.vibration.axis_origin, v.axis_origin);
-    vector("axis direction", was.vibration.axis_direction, v.axis_direction);
-  }
-  vector("gravity (m/s^2)", was.gravity, scene.gravity);
-  number("mu", was.mu, scene.material.mu);
-  if (changed.empty()) return "";
-  return std::string("its ") +
-         (law.drift_model == DriftModel::CalibratedDrift ? "calibrated drift was"
-                                                         : "part efficiency factors were") +
-         " measured for another feeder: " + changed;
-}
-
-bool uncheckedCalibration(const FeederLaw& law) {
-  return law.kind == FeederLaw::Kind::Vibration && law.drift_model != DriftModel::Local &&
-         !lacksCalibration(law) && !law.calibrated_for;
-}
-
 bool needsCalibration(const Scene& scene) {
   for (std::size_t i = 0; i < scene.fixtures.size(); ++i) {
     if (lacksCalibration(scene.fixtures[i].law) ||

@@ -403,6 +403,21 @@ void readLaw(const json& v, const std::string& path, FeederLaw& law,
         fail(b.at("method"),
              "unknown calibration method \"" + was.method + "\"; expected classical or sampling");
       }
+      Vec3 point;
+      if (b.opt("conveying_direction", point, UnitVector{})) was.conveying_direction = point;
+      if (b.opt("track_point", point)) was.track_point = point;
+      double restitution = 0;
+      if (b.opt("restitution", restitution, Range::UnitInterval)) was.restitution = restitution;
+      for (auto [key, digest] :
+           {std::pair<const char*, std::string*>{"parts_digest", &was.parts_digest},
+            {"fixtures_digest", &was.fixtures_digest}}) {
+        if (b.opt(key, *digest) &&
+            (digest->size() != 16 ||
+             digest->find_first_not_of("0123456789abcdef") != std::string::npos)) {
+          fail(b.at(key),
+               "expected 16 lowercase hex digits (as rheofeed writes it), got \"" + *digest + "\"");
+        }
+      }
       b.finish();
     }
     // Without drift_model: a law that carries a calibrated drift keeps using it (files written

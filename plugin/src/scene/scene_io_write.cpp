@@ -144,9 +144,15 @@ ojson toJson(const FeederLaw& law, const std::vector<PartSpec>& parts) {
         out["calibrated_for"] = ojson{{"vibration", toJson(law.calibrated_for->vibration)},
                                       {"gravity", toJson(law.calibrated_for->gravity)},
                                       {"mu", law.calibrated_for->mu}};
-        if (!law.calibrated_for->method.empty()) {
-          out["calibrated_for"]["method"] = law.calibrated_for->method;
-        }
+        const CalibrationBasis& was = *law.calibrated_for;
+        ojson& basis = out["calibrated_for"];
+        if (!was.method.empty()) basis["method"] = was.method;
+        if (was.conveying_direction)
+          basis["conveying_direction"] = toJson(*was.conveying_direction);
+        if (was.track_point) basis["track_point"] = toJson(*was.track_point);
+        if (was.restitution) basis["restitution"] = *was.restitution;
+        if (!was.parts_digest.empty()) basis["parts_digest"] = was.parts_digest;
+        if (!was.fixtures_digest.empty()) basis["fixtures_digest"] = was.fixtures_digest;
       }
       return out;
     }

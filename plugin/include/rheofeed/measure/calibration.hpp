@@ -67,8 +67,10 @@ Calibration calibrateClassical(const Scene& scene, int fixture);
 
 /// A copy of `scene` whose vibrating fixture carries `calibration` as its calibrated drift
 /// and drift_model calibrated_drift: rheonomic methods then use it. Its calibrated_for is set
-/// from `scene` (the fixture's vibration, the scene's gravity and mu): pass the scene that was
-/// calibrated, and a later edit of them makes the drift stale (staleCalibration).
+/// from `scene` by calibrationBasis (scene.hpp: the fixture's vibration, the scene's gravity,
+/// mu and what else `calibration.method` took from it, e.g. a sample run's parts): pass the
+/// scene that was calibrated, and a later edit of them makes the drift stale
+/// (staleCalibration).
 Scene withCalibration(Scene scene, const Calibration& calibration);
 
 /// How calibrateEfficiency runs (issue 8: the part's own efficiency under the local law).

@@ -104,9 +104,10 @@ const char* toString(DriftModel model);
 bool parseDriftModel(const std::string& name, DriftModel& model);
 
 /// What a feeder's calibrated drift or efficiency factors were measured for: the vibration and
-/// the scene's gravity and friction at the time (withCalibration, withEfficiency set it; scene
-/// files keep it as "calibrated_for"). A calibration is stale when the scene's now differ
-/// (staleCalibration): it would answer for another feeder.
+/// the scene's gravity and friction at the time, and what else the measurement depended on
+/// (calibrationBasis sets it; withCalibration, withEfficiency call it; scene files keep it as
+/// "calibrated_for"). A calibration is stale when the scene's now differ (staleCalibration): it
+/// would answer for another feeder, or for other parts.
 struct CalibrationBasis {
   Vibration vibration;
   Vec3 gravity{0, 0, -9.81};  ///< (m/s^2, world)
@@ -114,6 +115,19 @@ struct CalibrationBasis {
   /// How it was measured: "classical" (the classical single-part model), "sampling" (a
   /// full-vibration sample run), "" (not known). A stale calibration is redone the same way.
   std::string method;
+  /// A straight track's (no torsion): the direction the drift was measured along (unit,
+  /// world; Outputs::conveying_direction then). Unset: not recorded (a file written before it
+  /// was kept, or a screw, whose drift turns about its axis), not compared.
+  std::optional<Vec3> conveying_direction;
+  /// A classical calibration of a screw: the point whose track the model took (m, world; the
+  /// first part family's spawn-region centre, which sets the radius). Unset: not recorded.
+  std::optional<Vec3> track_point;
+  /// A sampling calibration's: the material's restitution (in [0, 1]) and the digests
+  /// (partsDigest, fixturesDigest: 16 hex digits) of the parts and the fixtures' geometry the
+  /// sample run ran. Unset or "": not recorded, not compared.
+  std::optional<double> restitution;
+  std::string parts_digest;
+  std::string fixtures_digest;
 };
 
 /// Largest part efficiency factor (dimensionless), as FeederSet::setPartEfficiency accepts.
@@ -369,13 +383,33 @@ MotionLaw rheonomicLaw(const Scene& scene, int fixture);
 /// local law needs none). rheonomicLaw refuses such a law.
 bool lacksCalibration(const FeederLaw& law);
 
+/// The basis of a calibration of fixture `fixture` (a vibrating feeder) of `scene` measured by
+/// `method` ("classical" or "sampling"): the vibration, gravity and mu; a straight track's
+/// conveying direction; a classical screw calibration's track point; a sampling calibration's
+/// restitution and the digests of its parts and fixtures. Throws std::out_of_range for a
+/// fixture index out of range.
+CalibrationBasis calibrationBasis(const Scene& scene, int fixture, const std::string& method);
+
+/// A digest (16 hex digits, 64-bit FNV-1a) of what a sampling calibration's run takes from the
+/// scene's parts: every family's shape, size distributions, mesh (its loaded triangles, not its
+/// path), collision shape, density, spawn region, orientation and initial velocity (not names,
+/// counts or rates). Numbers are taken to 9 significant digits, so that a scene read back from
+/// its file gives the same digest.
+std::string partsDigest(const Scene& scene);
+/// A digest, as partsDigest, of every fixture's geoms: shapes, sizes, meshes and poses at rest
+/// (not names or laws).
+std::string fixturesDigest(const Scene& scene);
+
 /// Why the calibration that fixture `fixture`'s drift model uses (its calibrated drift, or its
 /// efficiency factors under local_sampled) no longer fits `scene`: the fields of its
-/// CalibrationBasis that differ from the fixture's vibration and the scene's gravity and mu
-/// now, each with both values ("its calibrated drift was measured for another feeder:
-/// amplitude (m) 0.0005 when calibrated, 0.0008 now"); "" when it
-/// fits, when the law uses no calibration, or when its basis is not known. Phase is not
-/// compared (it does not change a steady drift).
+/// CalibrationBasis that differ from the fixture's vibration, the scene's gravity, mu,
+/// conveying direction (straight tracks), track point (classical screws), restitution, parts
+/// and fixtures' geometry (sampling calibrations) now, each with both values ("its calibrated
+/// drift was measured for another feeder: amplitude (m) 0.0005 when calibrated, 0.0008 now";
+/// "... measured with other parts: the parts (digest ...) 3f2a... when calibrated, 91c0...
+/// now"); "" when it fits, when the law uses no calibration, or when its basis is not known.
+/// Fields the basis does not record are not compared. Phase is not compared (it does not
+/// change a steady drift).
 std::string staleCalibration(const Scene& scene, int fixture);
 
 /// True when `law`'s drift model uses a calibration (a calibrated drift, or local_sampled's
