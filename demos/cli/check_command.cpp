@@ -54,6 +54,8 @@ int checkCommand(const SceneArgs& args) {
                 f.name.c_str(), toString(f.law.drift_model), missing.c_str());
     if (uncheckedCalibration(f.law)) {
       std::printf("note: %s\n", uncheckedCalibrationNote(f, args.scene).c_str());
+    } else if (partlyCheckedCalibration(f.law)) {
+      std::printf("note: %s\n", partlyCheckedCalibrationNote(f, args.scene).c_str());
     }
   }
   std::printf("%s\n",

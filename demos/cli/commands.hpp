@@ -55,6 +55,9 @@ void noteIgnoredCycleOptions(const char* program, bool cycles_given, bool calibr
 /// Why the calibration of `fixture` (uncheckedCalibration, scene.hpp) cannot be checked
 /// against the scene, with the command that records it; said by `run` and `check` for `scene`.
 std::string uncheckedCalibrationNote(const scene::Fixture& fixture, const std::string& scene);
+/// Why the calibration of `fixture` (partlyCheckedCalibration, scene.hpp) is checked against
+/// the feeder but not against the parts or fixtures, with the command that records them.
+std::string partlyCheckedCalibrationNote(const scene::Fixture& fixture, const std::string& scene);
 
 /// `rheofeed check SCENE`: loads and validates the scene, then prints the hazards of the scene
 /// check (check.hpp) for each method at the step it would take. Exit code 0 when there is no

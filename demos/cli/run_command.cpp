@@ -281,8 +281,11 @@ int runCommand(const RunArgs& args) {
       }
     }
     for (const Fixture& f : calibrated.fixtures) {  // a calibration that cannot be checked
-      if (!any_rheonomic || !uncheckedCalibration(f.law)) continue;
-      const std::string why = uncheckedCalibrationNote(f, args.scene.scene);
+      if (!any_rheonomic) continue;
+      if (!uncheckedCalibration(f.law) && !partlyCheckedCalibration(f.law)) continue;
+      const std::string why = uncheckedCalibration(f.law)
+                                  ? uncheckedCalibrationNote(f, args.scene.scene)
+                                  : partlyCheckedCalibrationNote(f, args.scene.scene);
       std::fprintf(stderr, "rheofeed run: warning: %s\n", why.c_str());
       calibration_warnings.push_back(why);
     }
@@ -376,13 +379,32 @@ int runCommand(const RunArgs& args) {
   return code != 0 ? code : no_answer.empty() ? 0 : kNoAnswerExitCode;
 }
 
+namespace {
+// `rheofeed calibrate` of `fixture`'s drift model again, recording what it is measured for.
+std::string recalibrateHint(const Fixture& fixture, const std::string& scene) {
+  return "`rheofeed calibrate " + scene + " --drift-model " + toString(fixture.law.drift_model) +
+         " --force --out NEW.json` measures it again and records what for";
+}
+const char* calibrationName(const Fixture& fixture) {
+  return fixture.law.drift_model == DriftModel::CalibratedDrift ? "calibrated drift"
+                                                                : "efficiency factors";
+}
+}  // namespace
+
 std::string uncheckedCalibrationNote(const Fixture& fixture, const std::string& scene) {
   return "fixture '" + fixture.name + "': the scene gives its calibration (" +
-         (fixture.law.drift_model == DriftModel::CalibratedDrift ? "calibrated drift"
-                                                                 : "efficiency factors") +
-         ") without calibrated_for: after a change of the vibration, gravity or mu since it was "
-         "measured it would be stale, and the run cannot tell (`rheofeed calibrate " +
-         scene + " --force --out NEW.json` measures it again and records what for)";
+         calibrationName(fixture) +
+         ") without calibrated_for: after a change of the vibration, gravity, mu, parts or "
+         "fixtures since it was measured it would be stale, and the run cannot tell (" +
+         recalibrateHint(fixture, scene) + ")";
+}
+
+std::string partlyCheckedCalibrationNote(const Fixture& fixture, const std::string& scene) {
+  return "fixture '" + fixture.name + "': the calibrated_for of its " + calibrationName(fixture) +
+         " records the feeder but no part or fixture digests (written before they were kept): "
+         "a change of the parts or of the fixtures' geometry since it was measured is not "
+         "noticed (" +
+         recalibrateHint(fixture, scene) + ")";
 }
 
 }  // namespace rheofeed::cli

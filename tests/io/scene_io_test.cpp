@@ -133,8 +133,8 @@ void expectSameScene(const Scene& a, const Scene& b) {
         expectSame(*ba.track_point, *bb.track_point, w + ".calibrated_for.track_point");
       }
       EXPECT_EQ(ba.restitution, bb.restitution) << w;
-      EXPECT_EQ(ba.parts_digest, bb.parts_digest) << w;
-      EXPECT_EQ(ba.fixtures_digest, bb.fixtures_digest) << w;
+      EXPECT_EQ(ba.part_digests, bb.part_digests) << w;
+      EXPECT_EQ(ba.fixture_digests, bb.fixture_digests) << w;
     }
     EXPECT_EQ(la.has_calibrated_drift, lb.has_calibrated_drift) << w;
     expectSame(la.calibrated_drift, lb.calibrated_drift, w + ".calibrated_drift");
@@ -273,8 +273,8 @@ Scene everyFieldScene() {
   basis.conveying_direction = Vec3{0.6, 0.8, 0};
   basis.track_point = Vec3{-2.86, 0.125, 0.0421};
   basis.restitution = 0.15;
-  basis.parts_digest = "0123456789abcdef";
-  basis.fixtures_digest = "fedcba9876543210";
+  basis.part_digests = {"0123456789abcdef", "", "00000000000000ff", "0123456789abcdef"};
+  basis.fixture_digests = {"fedcba9876543210", "fedcba9876543210", "0000000000000001"};
   bowl.law.calibrated_for->vibration.amplitude = 2.5e-4;  // calibrated for another amplitude
   s.fixtures.push_back(bowl);
 
@@ -359,9 +359,13 @@ TEST(SceneFile, RoundTripKeepsEveryField) {
   // What a sampling calibration records of the parts and fixtures (their digests, taken from
   // the loaded meshes and the rotations computed from angles) reads back the same.
   const Scene again = parseScene(toJson(back), "again.json", meshes.loader());
-  EXPECT_EQ(partsDigest(again), partsDigest(back));
-  EXPECT_EQ(fixturesDigest(again), fixturesDigest(back));
-  EXPECT_EQ(partsDigest(back).size(), 16u);
+  for (std::size_t k = 0; k < back.parts.size(); ++k) {
+    EXPECT_EQ(partDigest(again.parts[k]), partDigest(back.parts[k])) << k;
+  }
+  for (std::size_t i = 0; i < back.fixtures.size(); ++i) {
+    EXPECT_EQ(fixtureDigest(again.fixtures[i]), fixtureDigest(back.fixtures[i])) << i;
+  }
+  EXPECT_EQ(partDigest(back.parts[3]).size(), 16u);  // the mesh nuts
 }
 
 TEST(SceneFile, PartMeshIsCentredOnItsCentreOfMass) {
@@ -663,11 +667,13 @@ TEST(SceneFileErrors, OutOfRangeValuesNameThePath) {
       R"("angle_deg": 20}, "calibrated_drift": {"linear": [0.02, 0, 0]},
          "calibrated_for": {"vibration": {"amplitude": 2e-4, "frequency": 50, "angle_deg": 20},
                             "gravity": [0, 0, -9.81], "mu": 0.5, )";
-  refused(replaced(kGood, R"("angle_deg": 20})", basis + R"("parts_digest": "12ab"})"),
-          "fixtures[0].law.calibrated_for.parts_digest", "expected 16 lowercase hex digits");
-  refused(
-      replaced(kGood, R"("angle_deg": 20})", basis + R"("fixtures_digest": "0123456789ABCDEF"})"),
-      "fixtures[0].law.calibrated_for.fixtures_digest", "got \"0123456789ABCDEF\"");
+  refused(replaced(kGood, R"("angle_deg": 20})", basis + R"("part_digests": ["12ab"]})"),
+          "fixtures[0].law.calibrated_for.part_digests[0]", "expected 16 lowercase hex digits");
+  refused(replaced(kGood, R"("angle_deg": 20})", basis + R"("part_digests": "12ab"})"),
+          "fixtures[0].law.calibrated_for.part_digests", "expected an array");
+  refused(replaced(kGood, R"("angle_deg": 20})",
+                   basis + R"("fixture_digests": ["", "0123456789ABCDEF"]})"),
+          "fixtures[0].law.calibrated_for.fixture_digests[0]", "got \"\"");
   refused(replaced(kGood, R"("angle_deg": 20})", basis + R"("restitution": 1.5})"),
           "fixtures[0].law.calibrated_for.restitution", "must be in [0, 1]");
   refused(replaced(kGood, R"("angle_deg": 20})", basis + R"("conveying_direction": [0, 0, 0]})"),

@@ -201,8 +201,10 @@ TEST(StaleCalibration, ASampledCalibrationKnowsItsPartsFixturesAndRestitution) {
   c.method = "sampling";  // as calibrateBySampling returns it (the value itself is not used)
   const Scene calibrated = withCalibration(s, c);
   const CalibrationBasis& basis = *calibrated.fixtures[0].law.calibrated_for;
-  EXPECT_EQ(basis.parts_digest, partsDigest(s));
-  EXPECT_EQ(basis.fixtures_digest, fixturesDigest(s));
+  ASSERT_EQ(basis.part_digests.size(), 1u);
+  EXPECT_EQ(basis.part_digests[0], partDigest(s.parts[0]));
+  ASSERT_EQ(basis.fixture_digests.size(), 1u);
+  EXPECT_EQ(basis.fixture_digests[0], fixtureDigest(s.fixtures[0]));
   EXPECT_EQ(basis.restitution, s.material.restitution);
   ASSERT_TRUE(basis.conveying_direction.has_value());
   EXPECT_FALSE(basis.track_point.has_value());  // a straight track: no radius
@@ -221,10 +223,13 @@ TEST(StaleCalibration, ASampledCalibrationKnowsItsPartsFixturesAndRestitution) {
   Scene bigger = calibrated;
   bigger.parts[0].size[0].mean *= 1.5;
   const std::string why = staleCalibration(bigger, 0);
-  EXPECT_EQ(why.find("its calibrated drift was measured with other parts: the parts (digest"), 0u)
+  EXPECT_EQ(why.find("its calibrated drift was measured with other parts: parts[0] 'flat_box' "
+                     "(the digest of its shape, sizes"),
+            0u)
       << why;
-  EXPECT_NE(why.find(basis.parts_digest + " when calibrated, " + partsDigest(bigger) + " now"),
-            std::string::npos)
+  EXPECT_NE(
+      why.find(basis.part_digests[0] + " when calibrated, " + partDigest(bigger.parts[0]) + " now"),
+      std::string::npos)
       << why;
   EXPECT_TRUE(needsCalibration(bigger));
   EXPECT_THROW(rheonomicLaw(bigger, 0), std::invalid_argument);
@@ -240,14 +245,14 @@ TEST(StaleCalibration, ASampledCalibrationKnowsItsPartsFixturesAndRestitution) {
   Scene raised = calibrated;
   raised.fixtures[0].geoms[0].pose.position.z += 0.01;
   const std::string moved = staleCalibration(raised, 0);
-  EXPECT_EQ(moved.find("its calibrated drift was measured for another feeder: the fixtures' "
-                       "geometry (digest) " +
-                       basis.fixtures_digest + " when calibrated"),
+  EXPECT_EQ(moved.find("its calibrated drift was measured for another feeder: fixture 'track' "
+                       "(the digest of its geoms' shapes, sizes and poses) " +
+                       basis.fixture_digests[0] + " when calibrated"),
             0u)
       << moved;
   raised.parts[0].density *= 2;
   EXPECT_EQ(staleCalibration(raised, 0).find("its calibrated drift was measured for another "
-                                             "feeder and parts: the fixtures' geometry"),
+                                             "feeder and parts: fixture 'track'"),
             0u)
       << staleCalibration(raised, 0);
   Scene turned = calibrated;  // the drift is measured along the conveying direction
@@ -258,13 +263,95 @@ TEST(StaleCalibration, ASampledCalibrationKnowsItsPartsFixturesAndRestitution) {
       << staleCalibration(turned, 0);
 }
 
+// A calibrated drift is sampled on the first part family only, efficiency factors each on
+// their own: a change of another family does not make them stale, and the message names the
+// family that changed. After a change of the feeder, a factor measured again for one family
+// does not vouch for the others' old ones.
+TEST(StaleCalibration, EachCalibrationIsComparedOnTheFamiliesItSampled) {
+  Scene s = hoppingTrack();
+  PartSpec pins = s.parts[0];
+  pins.name = "pins";
+  pins.size[2].mean = 0.01;
+  s.parts.push_back(pins);
+  Calibration c = calibrateClassical(s, 0);
+  c.method = "sampling";
+  const Scene drift = withCalibration(s, c);
+  EXPECT_EQ(drift.fixtures[0].law.calibrated_for->part_digests.size(), 2u);
+  Scene longer_pins = drift;
+  longer_pins.parts[1].size[2].mean = 0.02;
+  EXPECT_EQ(staleCalibration(longer_pins, 0), "");  // the drift sampled the first family only
+  Scene wider_boxes = drift;
+  wider_boxes.parts[0].size[1].mean = 0.03;
+  EXPECT_EQ(staleCalibration(wider_boxes, 0)
+                .find("its calibrated drift was measured with other "
+                      "parts: parts[0] 'flat_box'"),
+            0u)
+      << staleCalibration(wider_boxes, 0);
+
+  EfficiencyCalibration e;
+  e.fixture = 0;
+  e.efficiency = 0.8;
+  e.family = 0;
+  Scene sampled = withEfficiency(s, e);
+  e.family = 1;
+  e.efficiency = 0.9;
+  sampled = withEfficiency(sampled, e);
+  EXPECT_EQ(staleCalibration(sampled, 0), "");
+  Scene pins_changed = sampled;
+  pins_changed.parts[1].density = 7800;
+  const std::string why = staleCalibration(pins_changed, 0);
+  EXPECT_EQ(why.find("its part efficiency factors were measured with other parts: parts[1] "
+                     "'pins'"),
+            0u)
+      << why;
+  EXPECT_EQ(why.find("flat_box"), std::string::npos) << why;  // only the family that changed
+  Scene another_family = sampled;
+  another_family.parts.push_back(pins);
+  EXPECT_NE(staleCalibration(another_family, 0)
+                .find("the number of part families 2 when "
+                      "calibrated, 3 now"),
+            std::string::npos)
+      << staleCalibration(another_family, 0);
+
+  // The feeder changes; the first family is measured again, the second is not.
+  Scene louder = sampled;
+  louder.fixtures[0].law.vibration.amplitude *= 1.5;
+  e.family = 0;
+  const Scene half = withEfficiency(louder, e);
+  const std::string half_why = staleCalibration(half, 0);
+  EXPECT_NE(half_why.find("parts[1] 'pins' (this record did not measure its factor"),
+            std::string::npos)
+      << half_why;
+  EXPECT_EQ(half_why.find("flat_box"), std::string::npos) << half_why;
+  e.family = 1;
+  EXPECT_EQ(staleCalibration(withEfficiency(half, e), 0), "");  // both measured again
+}
+
+// A record written before the digests were kept checks the feeder only, and says so.
+TEST(StaleCalibration, ARecordWithoutDigestsIsOnlyPartlyChecked) {
+  const Scene s = hoppingTrack();
+  Calibration c = calibrateClassical(s, 0);
+  const Scene classical = withCalibration(s, c);
+  EXPECT_FALSE(partlyCheckedCalibration(classical.fixtures[0].law));  // nothing else to digest
+  c.method = "sampling";
+  Scene old_file = withCalibration(s, c);
+  EXPECT_FALSE(partlyCheckedCalibration(old_file.fixtures[0].law));
+  old_file.fixtures[0].law.calibrated_for->part_digests.clear();
+  old_file.fixtures[0].law.calibrated_for->fixture_digests.clear();
+  EXPECT_TRUE(partlyCheckedCalibration(old_file.fixtures[0].law));
+  old_file.parts[0].density *= 3;
+  EXPECT_EQ(staleCalibration(old_file, 0), "");  // not noticed: hence the note
+  old_file.fixtures[0].law.drift_model = DriftModel::Local;
+  EXPECT_FALSE(partlyCheckedCalibration(old_file.fixtures[0].law));  // not used
+}
+
 // The classical model takes the vibration, gravity, mu, a straight track's direction and a
 // screw's radius (the spawn centre's), not the parts or the fixtures' shapes.
 TEST(StaleCalibration, AClassicalCalibrationKnowsItsTrackDirectionAndAScrewsRadius) {
   const Scene s = hoppingTrack();
   const Scene calibrated = withCalibration(s, calibrateClassical(s, 0));
   const CalibrationBasis& basis = *calibrated.fixtures[0].law.calibrated_for;
-  EXPECT_TRUE(basis.parts_digest.empty());
+  EXPECT_TRUE(basis.part_digests.empty());
   EXPECT_FALSE(basis.restitution.has_value());
   Scene other_parts = calibrated;
   other_parts.parts[0].size[0].mean *= 2;

@@ -144,11 +144,15 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
       if (law.has_calibrated_drift && !sampled.fixtures[i].law.has_calibrated_drift) {
         // withEfficiency: one calibrated_for serves both; a drift not known to fit this
         // feeder would pass for one
+        Scene as_drift = scene;
+        as_drift.fixtures[i].law.drift_model = DriftModel::CalibratedDrift;
+        const std::string why =
+            law.calibrated_for ? staleCalibration(as_drift, fixture)
+                               : "it records no calibrated_for (given by hand, or an older file)";
         std::fprintf(log,
-                     "%s: fixture '%s': its calibrated drift is dropped: it was not recorded as "
-                     "measured for this vibration, gravity and mu (calibrated_for), which the "
-                     "efficiency factors now record\n",
-                     label.c_str(), name.c_str());
+                     "%s: fixture '%s': its calibrated drift is dropped (the efficiency factors' "
+                     "calibrated_for, which it would share, cannot vouch for it): %s\n",
+                     label.c_str(), name.c_str(), why.c_str());
       }
       scene = sampled;
     }

@@ -270,10 +270,33 @@ Scene withEfficiency(Scene scene, const EfficiencyCalibration& calibration) {
       law.has_calibrated_drift = false;
     }
   }
+  // The record now vouches for every family's factor: the others keep their digests where
+  // the old record fits this feeder (apart from the parts), and are marked not measured ("")
+  // where it does not; factors set by default or by hand (no record) count as given.
+  CalibrationBasis next = calibrationBasis(scene, calibration.fixture, "sampling");
+  const bool had_factors =
+      law.drift_model == DriftModel::LocalSampled && !law.efficiency.empty() && law.calibrated_for;
+  bool feeder_fits = true;
+  if (had_factors) {
+    Scene apart_from_parts = scene;
+    apart_from_parts.fixtures[static_cast<std::size_t>(calibration.fixture)]
+        .law.calibrated_for->part_digests.clear();
+    feeder_fits = staleCalibration(apart_from_parts, calibration.fixture).empty();
+  }
+  const std::vector<std::string> old =
+      had_factors ? law.calibrated_for->part_digests : std::vector<std::string>{};
+  for (std::size_t j = 0; j < next.part_digests.size(); ++j) {
+    if (j == static_cast<std::size_t>(calibration.family)) continue;
+    if (!feeder_fits) {
+      next.part_digests[j].clear();
+    } else if (old.size() == next.part_digests.size()) {
+      next.part_digests[j] = old[j];
+    }
+  }
   law.drift_model = DriftModel::LocalSampled;
   if (law.efficiency.size() != scene.parts.size()) law.efficiency.assign(scene.parts.size(), 1.0);
   law.efficiency[static_cast<std::size_t>(calibration.family)] = calibration.efficiency;
-  law.calibrated_for = calibrationBasis(scene, calibration.fixture, "sampling");
+  law.calibrated_for = next;
   return scene;
 }
 

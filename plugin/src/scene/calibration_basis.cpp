@@ -2,6 +2,7 @@
 // What a calibration was measured for (CalibrationBasis, scene.hpp), and whether a scene still
 // fits it (staleCalibration): the feeder's vibration, gravity and friction, the direction the
 // drift is measured along, and for a sample run the parts and the fixtures' geometry it ran.
+#include <charconv>
 #include <cinttypes>
 #include <cmath>
 #include <cstdint>
@@ -23,8 +24,10 @@ class Digest {
   Digest& operator<<(double x) {
     char text[32];
     if (!(std::abs(x) >= 1e-12)) x = 0;  // also -0; NaN cannot reach a validated scene
-    std::snprintf(text, sizeof text, "%.9g;", x);
-    return *this << std::string(text);
+    // std::to_chars: the same text under any C locale (snprintf would write "0,5" in some)
+    const auto end = std::to_chars(text, text + sizeof text - 1, x, std::chars_format::general, 9);
+    *end.ptr = ';';
+    return *this << std::string(text, end.ptr + 1);
   }
   Digest& operator<<(int x) { return *this << static_cast<double>(x); }
   Digest& operator<<(const Vec3& x) { return *this << x.x << x.y << x.z; }
@@ -59,45 +62,39 @@ bool isScrew(const Vibration& v) {
 
 }  // namespace
 
-std::string partsDigest(const Scene& scene) {
+std::string partDigest(const PartSpec& p) {
   Digest d;
-  d << static_cast<int>(scene.parts.size());
-  for (const PartSpec& p : scene.parts) {
-    d << toString(p.shape);
-    for (const Distribution& s : p.size) d << s.mean << s.stddev << s.min << s.max;
-    d << p.mesh_data.get() << (p.collision == PartSpec::Collision::ConvexHull ? "hull" : "mesh");
-    d << p.density << p.spawn_min << p.spawn_max << (p.random_orientation ? "random" : "fixed")
-      << p.initial_velocity;
-  }
+  d << toString(p.shape);
+  for (const Distribution& s : p.size) d << s.mean << s.stddev << s.min << s.max;
+  d << p.mesh_data.get() << (p.collision == PartSpec::Collision::ConvexHull ? "hull" : "mesh");
+  d << p.density << p.spawn_min << p.spawn_max << (p.random_orientation ? "random" : "fixed")
+    << p.initial_velocity;
   return d.hex();
 }
 
-std::string fixturesDigest(const Scene& scene) {
+std::string fixtureDigest(const Fixture& f) {
   Digest d;
-  d << static_cast<int>(scene.fixtures.size());
-  for (const Fixture& f : scene.fixtures) {
-    d << static_cast<int>(f.geoms.size());
-    for (const Fixture::Geom& g : f.geoms) {
-      d << toString(g.shape.kind) << g.pose.position;
-      for (const double r : g.pose.rotation) d << r;
-      switch (g.shape.kind) {
-        case Shape::Kind::Box:
-          d << g.shape.size;
-          break;
-        case Shape::Kind::Sphere:
-          d << g.shape.radius;
-          break;
-        case Shape::Kind::Cylinder:
-        case Shape::Kind::Capsule:
-          d << g.shape.radius << g.shape.length;
-          break;
-        case Shape::Kind::Plane:
-          d << g.shape.plane_normal << g.shape.plane_offset;
-          break;
-        case Shape::Kind::Mesh:
-          d << g.shape.mesh_data.get();
-          break;
-      }
+  d << static_cast<int>(f.geoms.size());
+  for (const Fixture::Geom& g : f.geoms) {
+    d << toString(g.shape.kind) << g.pose.position;
+    for (const double r : g.pose.rotation) d << r;
+    switch (g.shape.kind) {
+      case Shape::Kind::Box:
+        d << g.shape.size;
+        break;
+      case Shape::Kind::Sphere:
+        d << g.shape.radius;
+        break;
+      case Shape::Kind::Cylinder:
+      case Shape::Kind::Capsule:
+        d << g.shape.radius << g.shape.length;
+        break;
+      case Shape::Kind::Plane:
+        d << g.shape.plane_normal << g.shape.plane_offset;
+        break;
+      case Shape::Kind::Mesh:
+        d << g.shape.mesh_data.get();
+        break;
     }
   }
   return d.hex();
@@ -118,8 +115,8 @@ CalibrationBasis calibrationBasis(const Scene& scene, int fixture, const std::st
   }
   if (method == "sampling") {
     basis.restitution = scene.material.restitution;
-    basis.parts_digest = partsDigest(scene);
-    basis.fixtures_digest = fixturesDigest(scene);
+    for (const PartSpec& p : scene.parts) basis.part_digests.push_back(partDigest(p));
+    for (const Fixture& f : scene.fixtures) basis.fixture_digests.push_back(fixtureDigest(f));
   }
   return basis;
 }
@@ -175,15 +172,52 @@ std::string staleCalibration(const Scene& scene, int fixture) {
     vector("track point (m, the first part family's spawn centre)", *was.track_point,
            0.5 * (scene.parts[0].spawn_min + scene.parts[0].spawn_max));
   }
-  if (!was.fixtures_digest.empty() && was.fixtures_digest != fixturesDigest(scene)) {
-    note(feeder, "the fixtures' geometry (digest)", was.fixtures_digest, fixturesDigest(scene));
+  if (was.restitution) number(feeder, "restitution", *was.restitution, scene.material.restitution);
+  // Each fixture's geometry: the sample run's parts may meet any of them.
+  if (!was.fixture_digests.empty()) {
+    if (was.fixture_digests.size() != scene.fixtures.size()) {
+      note(feeder, "the number of fixtures", std::to_string(was.fixture_digests.size()),
+           std::to_string(scene.fixtures.size()));
+    } else {
+      for (std::size_t i = 0; i < scene.fixtures.size(); ++i) {
+        const std::string now = fixtureDigest(scene.fixtures[i]);
+        if (was.fixture_digests[i] != now) {
+          note(feeder,
+               "fixture '" + scene.fixtures[i].name +
+                   "' (the digest of its geoms' shapes, sizes "
+                   "and poses)",
+               was.fixture_digests[i], now);
+        }
+      }
+    }
   }
-  if (was.restitution) number(parts, "restitution", *was.restitution, scene.material.restitution);
-  if (!was.parts_digest.empty() && was.parts_digest != partsDigest(scene)) {
-    note(parts,
-         "the parts (digest of every family's shape, sizes, mesh, density, spawn region, "
-         "orientation and initial velocity)",
-         was.parts_digest, partsDigest(scene));
+  // The part families the calibration sampled: a calibrated drift the first (the sample run's
+  // only family), efficiency factors each their own. "" marks a family whose factor this record
+  // has not measured (withEfficiency, after a change of the feeder).
+  if (!was.part_digests.empty() && !scene.parts.empty()) {
+    const bool drift = law.drift_model == DriftModel::CalibratedDrift;
+    const std::size_t families = drift ? 1 : scene.parts.size();
+    if (!drift && was.part_digests.size() != scene.parts.size()) {
+      note(parts, "the number of part families", std::to_string(was.part_digests.size()),
+           std::to_string(scene.parts.size()));
+    } else {
+      for (std::size_t k = 0; k < families; ++k) {
+        const std::string now = partDigest(scene.parts[k]);
+        const std::string& then = was.part_digests[k];
+        const std::string family = "parts[" + std::to_string(k) + "] '" + scene.parts[k].name + "'";
+        if (then.empty()) {
+          parts += (parts.empty() ? "" : ", ") + family +
+                   " (this record did not measure its factor: it was measured for the feeder as it "
+                   "was before)";
+        } else if (then != now) {
+          note(parts,
+               family +
+                   " (the digest of its shape, sizes, mesh, density, spawn region, orientation "
+                   "and initial velocity)",
+               then, now);
+        }
+      }
+    }
   }
   if (feeder.empty() && parts.empty()) return "";
   const std::string what = !parts.empty() && feeder.empty() ? "with other parts: "
@@ -198,6 +232,12 @@ std::string staleCalibration(const Scene& scene, int fixture) {
 bool uncheckedCalibration(const FeederLaw& law) {
   return law.kind == FeederLaw::Kind::Vibration && law.drift_model != DriftModel::Local &&
          !lacksCalibration(law) && !law.calibrated_for;
+}
+
+bool partlyCheckedCalibration(const FeederLaw& law) {
+  return law.kind == FeederLaw::Kind::Vibration && law.drift_model != DriftModel::Local &&
+         !lacksCalibration(law) && law.calibrated_for &&
+         law.calibrated_for->method != "classical" && law.calibrated_for->part_digests.empty();
 }
 
 }  // namespace rheofeed::scene

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -408,14 +409,31 @@ void readLaw(const json& v, const std::string& path, FeederLaw& law,
       if (b.opt("track_point", point)) was.track_point = point;
       double restitution = 0;
       if (b.opt("restitution", restitution, Range::UnitInterval)) was.restitution = restitution;
-      for (auto [key, digest] :
-           {std::pair<const char*, std::string*>{"parts_digest", &was.parts_digest},
-            {"fixtures_digest", &was.fixtures_digest}}) {
-        if (b.opt(key, *digest) &&
-            (digest->size() != 16 ||
-             digest->find_first_not_of("0123456789abcdef") != std::string::npos)) {
-          fail(b.at(key),
-               "expected 16 lowercase hex digits (as rheofeed writes it), got \"" + *digest + "\"");
+      // One digest per part family and per fixture (partDigest, fixtureDigest): 16 lowercase
+      // hex digits each, or "" for a family whose factor the record did not measure.
+      for (auto [key, digests, blank] : {std::tuple<const char*, std::vector<std::string>*, bool>{
+                                             "part_digests", &was.part_digests, true},
+                                         {"fixture_digests", &was.fixture_digests, false}}) {
+        const json* list = b.find(key);
+        if (!list) continue;
+        const std::string where = b.at(key);
+        if (!list->is_array() || list->size() > static_cast<std::size_t>(limits::kMaxGeoms)) {
+          fail(where, "expected an array of at most " + std::to_string(limits::kMaxGeoms) +
+                          " digests (16 hex digits each, as rheofeed writes them), got " +
+                          describe(*list));
+        }
+        for (std::size_t i = 0; i < list->size(); ++i) {
+          const std::string at = where + "[" + std::to_string(i) + "]";
+          std::string digest;
+          read((*list)[i], at, digest);
+          const bool hex = digest.size() == 16 &&
+                           digest.find_first_not_of("0123456789abcdef") == std::string::npos;
+          if (!hex && !(blank && digest.empty())) {
+            fail(at, std::string("expected 16 lowercase hex digits") +
+                         (blank ? " or \"\" (not measured)" : "") +
+                         " (as rheofeed writes them), got \"" + digest + "\"");
+          }
+          digests->push_back(digest);
         }
       }
       b.finish();

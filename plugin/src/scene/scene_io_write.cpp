@@ -151,8 +151,8 @@ ojson toJson(const FeederLaw& law, const std::vector<PartSpec>& parts) {
           basis["conveying_direction"] = toJson(*was.conveying_direction);
         if (was.track_point) basis["track_point"] = toJson(*was.track_point);
         if (was.restitution) basis["restitution"] = *was.restitution;
-        if (!was.parts_digest.empty()) basis["parts_digest"] = was.parts_digest;
-        if (!was.fixtures_digest.empty()) basis["fixtures_digest"] = was.fixtures_digest;
+        if (!was.part_digests.empty()) basis["part_digests"] = was.part_digests;
+        if (!was.fixture_digests.empty()) basis["fixture_digests"] = was.fixture_digests;
       }
       return out;
     }

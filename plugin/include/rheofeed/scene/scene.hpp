@@ -122,12 +122,16 @@ struct CalibrationBasis {
   /// A classical calibration of a screw: the point whose track the model took (m, world; the
   /// first part family's spawn-region centre, which sets the radius). Unset: not recorded.
   std::optional<Vec3> track_point;
-  /// A sampling calibration's: the material's restitution (in [0, 1]) and the digests
-  /// (partsDigest, fixturesDigest: 16 hex digits) of the parts and the fixtures' geometry the
-  /// sample run ran. Unset or "": not recorded, not compared.
+  /// A sampling calibration's: the material's restitution (in [0, 1]), and the digests (16 hex
+  /// digits) of each part family (partDigest, in the order of Scene::parts) and of each
+  /// fixture's geometry (fixtureDigest, in the order of Scene::fixtures) that the sample runs
+  /// ran. A calibrated drift is compared on the first family only (its sample run's family),
+  /// efficiency factors on every family; "" marks a family whose factor this record did not
+  /// measure (withEfficiency after a change of the feeder). Unset or empty: not recorded (a
+  /// classical calibration, or a file written before they were kept), not compared.
   std::optional<double> restitution;
-  std::string parts_digest;
-  std::string fixtures_digest;
+  std::vector<std::string> part_digests;
+  std::vector<std::string> fixture_digests;
 };
 
 /// Largest part efficiency factor (dimensionless), as FeederSet::setPartEfficiency accepts.
@@ -386,31 +390,39 @@ bool lacksCalibration(const FeederLaw& law);
 /// The basis of a calibration of fixture `fixture` (a vibrating feeder) of `scene` measured by
 /// `method` ("classical" or "sampling"): the vibration, gravity and mu; a straight track's
 /// conveying direction; a classical screw calibration's track point; a sampling calibration's
-/// restitution and the digests of its parts and fixtures. Throws std::out_of_range for a
+/// restitution and the digests of every part family and fixture. Throws std::out_of_range for a
 /// fixture index out of range.
 CalibrationBasis calibrationBasis(const Scene& scene, int fixture, const std::string& method);
 
-/// A digest (16 hex digits, 64-bit FNV-1a) of what a sampling calibration's run takes from the
-/// scene's parts: every family's shape, size distributions, mesh (its loaded triangles, not its
-/// path), collision shape, density, spawn region, orientation and initial velocity (not names,
-/// counts or rates). Numbers are taken to 9 significant digits, so that a scene read back from
-/// its file gives the same digest.
-std::string partsDigest(const Scene& scene);
-/// A digest, as partsDigest, of every fixture's geoms: shapes, sizes, meshes and poses at rest
-/// (not names or laws).
-std::string fixturesDigest(const Scene& scene);
+/// A digest (16 hex digits, 64-bit FNV-1a) of what a sampling calibration's run takes from a
+/// part family: its shape, size distributions, mesh (the loaded triangles, not the file's path),
+/// collision shape, density, spawn region, orientation and initial velocity (not its name,
+/// count or rate, nor the solver's settings). Numbers are taken to 9 significant digits
+/// (locale-independent), so that a scene read back from its file gives the same digest. A mesh
+/// is hashed as loaded (after assimp's processing and centring): another assimp may change it,
+/// which makes its calibrations stale, said.
+std::string partDigest(const PartSpec& parts);
+/// A digest, as partDigest, of a fixture's geoms: shapes, sizes, meshes and poses at rest (not
+/// its name or law).
+std::string fixtureDigest(const Fixture& fixture);
 
 /// Why the calibration that fixture `fixture`'s drift model uses (its calibrated drift, or its
 /// efficiency factors under local_sampled) no longer fits `scene`: the fields of its
 /// CalibrationBasis that differ from the fixture's vibration, the scene's gravity, mu,
-/// conveying direction (straight tracks), track point (classical screws), restitution, parts
-/// and fixtures' geometry (sampling calibrations) now, each with both values ("its calibrated
-/// drift was measured for another feeder: amplitude (m) 0.0005 when calibrated, 0.0008 now";
-/// "... measured with other parts: the parts (digest ...) 3f2a... when calibrated, 91c0...
-/// now"); "" when it fits, when the law uses no calibration, or when its basis is not known.
-/// Fields the basis does not record are not compared. Phase is not compared (it does not
-/// change a steady drift).
+/// conveying direction (straight tracks), track point (classical screws), restitution, part
+/// families and fixtures' geometry (sampling calibrations) now, each with both values ("its
+/// calibrated drift was measured for another feeder: amplitude (m) 0.0005 when calibrated, 0.0008
+/// now";
+/// "... measured with other parts: parts[0] 'plates' (the digest of ...) 3f2a... when
+/// calibrated, 91c0... now"); "" when it fits, when the law uses no calibration, or when its basis
+/// is not known. Fields the basis does not record are not compared. Phase is not compared (it does
+/// not change a steady drift).
 std::string staleCalibration(const Scene& scene, int fixture);
+
+/// True when `law`'s drift model uses a calibration measured by sampling (or by a method not
+/// recorded) whose calibrated_for records no part or fixture digests (a file written before
+/// they were kept): a change of the parts or fixtures since cannot be noticed. Callers say so.
+bool partlyCheckedCalibration(const FeederLaw& law);
 
 /// True when `law`'s drift model uses a calibration (a calibrated drift, or local_sampled's
 /// efficiency factors) that does not say what it was measured for (no calibrated_for: given by
