@@ -381,13 +381,20 @@ TEST(StaleCalibration, AClassicalCalibrationKnowsItsTrackDirectionAndAScrewsRadi
   Scene spun = bowl;
   spun.outputs.conveying_direction = {0, 1, 0};
   EXPECT_EQ(staleCalibration(spun, 0), "");
-  Scene wider = bowl;  // the spawn region further from the axis: another radius
-  wider.parts[0].spawn_min.y -= 0.2;
-  wider.parts[0].spawn_max.y -= 0.2;
-  EXPECT_NE(staleCalibration(wider, 0).find("track point (m, the first part family's spawn "
-                                            "centre)"),
+  Scene nearer = bowl;  // the spawn region nearer the axis: another radius
+  nearer.parts[0].spawn_min.y -= 0.2;
+  nearer.parts[0].spawn_max.y -= 0.2;
+  EXPECT_NE(staleCalibration(nearer, 0).find("track radius (m, the first part family's spawn "
+                                             "centre from the axis) 0.5 when calibrated, 0.3 now"),
             std::string::npos)
-      << staleCalibration(wider, 0);
+      << staleCalibration(nearer, 0);
+  Scene round = bowl;  // the spawn region turned half way round the axis: the same radius
+  for (Vec3* p : {&round.parts[0].spawn_min, &round.parts[0].spawn_max}) {
+    p->y = -1.0 - p->y;  // mirrored through the axis at y = -0.5
+    p->z += 0.01;        // and raised: the screw's vibration does not change along its axis
+  }
+  std::swap(round.parts[0].spawn_min.y, round.parts[0].spawn_max.y);
+  EXPECT_EQ(staleCalibration(round, 0), "");
 }
 
 TEST(CalibrateScene, CalibratesAStaleCalibrationAgainAndSaysWhy) {

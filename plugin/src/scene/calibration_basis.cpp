@@ -169,8 +169,14 @@ std::string staleCalibration(const Scene& scene, int fixture) {
     vector("conveying direction", *was.conveying_direction, scene.outputs.conveying_direction);
   }
   if (was.track_point && isScrew(v) && !scene.parts.empty()) {
-    vector("track point (m, the first part family's spawn centre)", *was.track_point,
-           0.5 * (scene.parts[0].spawn_min + scene.parts[0].spawn_max));
+    // The model takes the track at the point's distance from the axis (its vibration there);
+    // a point moved round the axis or along it is the same track.
+    const auto radius = [&v](const Vec3& point) {
+      return norm(tangentialPart(point - v.axis_origin, v.axis_direction));
+    };
+    number(feeder, "track radius (m, the first part family's spawn centre from the axis)",
+           radius(*was.track_point),
+           radius(0.5 * (scene.parts[0].spawn_min + scene.parts[0].spawn_max)));
   }
   if (was.restitution) number(feeder, "restitution", *was.restitution, scene.material.restitution);
   // Each fixture's geometry: the sample run's parts may meet any of them.

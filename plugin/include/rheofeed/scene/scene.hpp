@@ -120,7 +120,8 @@ struct CalibrationBasis {
   /// was kept, or a screw, whose drift turns about its axis), not compared.
   std::optional<Vec3> conveying_direction;
   /// A classical calibration of a screw: the point whose track the model took (m, world; the
-  /// first part family's spawn-region centre, which sets the radius). Unset: not recorded.
+  /// first part family's spawn-region centre); its distance from the axis is compared. Unset:
+  /// not recorded.
   std::optional<Vec3> track_point;
   /// A sampling calibration's: the material's restitution (in [0, 1]), and the digests (16 hex
   /// digits) of each part family (partDigest, in the order of Scene::parts) and of each
