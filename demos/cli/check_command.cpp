@@ -45,16 +45,18 @@ int checkCommand(const SceneArgs& args) {
         !stale.empty() ? ", but " + stale +
                              ": `rheofeed run` calibrates it again at every launch, "
                              "`rheofeed calibrate " +
-                             args.scene + " --out NEW.json` saves the new one"
+                             args.scene + " --drift-model " + toString(f.law.drift_model) +
+                             " --out NEW.json` saves the new one"
         : lacksCalibration(f.law) ? ", which the scene does not give: `rheofeed run` calibrates it "
                                     "at every launch, `rheofeed calibrate " +
-                                        args.scene + " --out NEW.json` saves it"
+                                        args.scene + " --drift-model " +
+                                        toString(f.law.drift_model) + " --out NEW.json` saves it"
                                   : std::string();
     std::printf("note: fixture '%s' vibrates; rheonomic runs use drift model %s%s\n",
                 f.name.c_str(), toString(f.law.drift_model), missing.c_str());
     if (uncheckedCalibration(f.law)) {
       std::printf("note: %s\n", uncheckedCalibrationNote(f, args.scene).c_str());
-    } else if (partlyCheckedCalibration(f.law)) {
+    } else if (!missingDigests(f.law).empty()) {
       std::printf("note: %s\n", partlyCheckedCalibrationNote(f, args.scene).c_str());
     }
   }

@@ -55,7 +55,7 @@ void noteIgnoredCycleOptions(const char* program, bool cycles_given, bool calibr
 /// Why the calibration of `fixture` (uncheckedCalibration, scene.hpp) cannot be checked
 /// against the scene, with the command that records it; said by `run` and `check` for `scene`.
 std::string uncheckedCalibrationNote(const scene::Fixture& fixture, const std::string& scene);
-/// Why the calibration of `fixture` (partlyCheckedCalibration, scene.hpp) is checked against
+/// Why the calibration of `fixture` (missingDigests, scene.hpp) is checked against
 /// the feeder but not against the parts or fixtures, with the command that records them.
 std::string partlyCheckedCalibrationNote(const scene::Fixture& fixture, const std::string& scene);
 

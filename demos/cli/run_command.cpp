@@ -282,7 +282,7 @@ int runCommand(const RunArgs& args) {
     }
     for (const Fixture& f : calibrated.fixtures) {  // a calibration that cannot be checked
       if (!any_rheonomic) continue;
-      if (!uncheckedCalibration(f.law) && !partlyCheckedCalibration(f.law)) continue;
+      if (!uncheckedCalibration(f.law) && !!missingDigests(f.law).empty()) continue;
       const std::string why = uncheckedCalibration(f.law)
                                   ? uncheckedCalibrationNote(f, args.scene.scene)
                                   : partlyCheckedCalibrationNote(f, args.scene.scene);
@@ -400,11 +400,14 @@ std::string uncheckedCalibrationNote(const Fixture& fixture, const std::string& 
 }
 
 std::string partlyCheckedCalibrationNote(const Fixture& fixture, const std::string& scene) {
+  const std::string missing = missingDigests(fixture.law);
   return "fixture '" + fixture.name + "': the calibrated_for of its " + calibrationName(fixture) +
-         " records the feeder but no part or fixture digests (written before they were kept): "
-         "a change of the parts or of the fixtures' geometry since it was measured is not "
-         "noticed (" +
-         recalibrateHint(fixture, scene) + ")";
+         " records the feeder but no " + missing +
+         " digests (written before they were kept): a change of the " +
+         (missing == "part"      ? "parts"
+          : missing == "fixture" ? "fixtures' geometry"
+                                 : "parts or of the fixtures' geometry") +
+         " since it was measured is not noticed (" + recalibrateHint(fixture, scene) + ")";
 }
 
 }  // namespace rheofeed::cli

@@ -177,10 +177,16 @@ TEST(StaleCalibration, LocalSampledEfficienciesKeepWhatTheyWereMeasuredFor) {
   c.efficiency = 0.8;
   const Scene sampled = withEfficiency(s, c);
   EXPECT_EQ(staleCalibration(sampled, 0), "");
-  // A calibrated drift kept beside the factors shares their record: one measured for this
-  // feeder stays, one of unknown origin (no calibrated_for) does not pass for it.
-  Scene drift_too = withCalibration(s, calibrateClassical(s, 0));
+  // A calibrated drift kept beside the factors shares their record: one sampled for this
+  // feeder and these parts stays; one of unknown origin (no calibrated_for), or a classical one
+  // (whose own record the sampling record would replace), does not pass for it.
+  Calibration sampled_drift = calibrateClassical(s, 0);
+  sampled_drift.method = "sampling";
+  Scene drift_too = withCalibration(s, sampled_drift);
   EXPECT_TRUE(withEfficiency(drift_too, c).fixtures[0].law.has_calibrated_drift);
+  EXPECT_FALSE(withEfficiency(withCalibration(s, calibrateClassical(s, 0)), c)
+                   .fixtures[0]
+                   .law.has_calibrated_drift);
   drift_too.fixtures[0].law.calibrated_for.reset();
   EXPECT_FALSE(withEfficiency(drift_too, c).fixtures[0].law.has_calibrated_drift);
   Scene faster = sampled;
@@ -293,6 +299,12 @@ TEST(StaleCalibration, EachCalibrationIsComparedOnTheFamiliesItSampled) {
   e.efficiency = 0.8;
   e.family = 0;
   Scene sampled = withEfficiency(s, e);
+  // The second family's factor (1 by default) was not measured: stale until it is.
+  EXPECT_NE(staleCalibration(sampled, 0)
+                .find("parts[1] 'pins' (its factor is not one this "
+                      "record measured: calibrate every family)"),
+            std::string::npos)
+      << staleCalibration(sampled, 0);
   e.family = 1;
   e.efficiency = 0.9;
   sampled = withEfficiency(sampled, e);
@@ -319,7 +331,7 @@ TEST(StaleCalibration, EachCalibrationIsComparedOnTheFamiliesItSampled) {
   e.family = 0;
   const Scene half = withEfficiency(louder, e);
   const std::string half_why = staleCalibration(half, 0);
-  EXPECT_NE(half_why.find("parts[1] 'pins' (this record did not measure its factor"),
+  EXPECT_NE(half_why.find("parts[1] 'pins' (its factor is not one this record measured"),
             std::string::npos)
       << half_why;
   EXPECT_EQ(half_why.find("flat_box"), std::string::npos) << half_why;
@@ -332,17 +344,18 @@ TEST(StaleCalibration, ARecordWithoutDigestsIsOnlyPartlyChecked) {
   const Scene s = hoppingTrack();
   Calibration c = calibrateClassical(s, 0);
   const Scene classical = withCalibration(s, c);
-  EXPECT_FALSE(partlyCheckedCalibration(classical.fixtures[0].law));  // nothing else to digest
+  EXPECT_EQ(missingDigests(classical.fixtures[0].law), "");  // nothing else to digest
   c.method = "sampling";
   Scene old_file = withCalibration(s, c);
-  EXPECT_FALSE(partlyCheckedCalibration(old_file.fixtures[0].law));
-  old_file.fixtures[0].law.calibrated_for->part_digests.clear();
+  EXPECT_EQ(missingDigests(old_file.fixtures[0].law), "");
   old_file.fixtures[0].law.calibrated_for->fixture_digests.clear();
-  EXPECT_TRUE(partlyCheckedCalibration(old_file.fixtures[0].law));
+  EXPECT_EQ(missingDigests(old_file.fixtures[0].law), "fixture");
+  old_file.fixtures[0].law.calibrated_for->part_digests.clear();
+  EXPECT_EQ(missingDigests(old_file.fixtures[0].law), "part or fixture");
   old_file.parts[0].density *= 3;
   EXPECT_EQ(staleCalibration(old_file, 0), "");  // not noticed: hence the note
   old_file.fixtures[0].law.drift_model = DriftModel::Local;
-  EXPECT_FALSE(partlyCheckedCalibration(old_file.fixtures[0].law));  // not used
+  EXPECT_EQ(missingDigests(old_file.fixtures[0].law), "");  // not used
 }
 
 // The classical model takes the vibration, gravity, mu, a straight track's direction and a
@@ -368,6 +381,7 @@ TEST(StaleCalibration, AClassicalCalibrationKnowsItsTrackDirectionAndAScrewsRadi
   v.torsion_amplitude = 0.003;
   v.axis_origin = {0, -0.5, 0};
   v.axis_direction = {0, 0, 1};
+  v.direction = {0, 0, 1};  // a bowl's screw: translation and gravity along the axis
   Calibration twist;
   twist.fixture = 0;
   twist.method = "classical";
@@ -395,6 +409,17 @@ TEST(StaleCalibration, AClassicalCalibrationKnowsItsTrackDirectionAndAScrewsRadi
   }
   std::swap(round.parts[0].spawn_min.y, round.parts[0].spawn_max.y);
   EXPECT_EQ(staleCalibration(round, 0), "");
+  // With the translation tilted off the axis, the place round the axis matters too.
+  Scene tilted = screw;
+  tilted.fixtures[0].law.vibration.direction = {std::cos(kBeta), 0, std::sin(kBeta)};
+  Scene tilted_round = withCalibration(tilted, twist);
+  tilted_round.parts[0] = round.parts[0];
+  EXPECT_NE(staleCalibration(tilted_round, 0)
+                .find("track point (m, the first part family's "
+                      "spawn centre) [0, 0, 0.0025] when "
+                      "calibrated"),
+            std::string::npos)
+      << staleCalibration(tilted_round, 0);
 }
 
 TEST(CalibrateScene, CalibratesAStaleCalibrationAgainAndSaysWhy) {

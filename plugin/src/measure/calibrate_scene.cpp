@@ -146,9 +146,16 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
         // feeder would pass for one
         Scene as_drift = scene;
         as_drift.fixtures[i].law.drift_model = DriftModel::CalibratedDrift;
-        const std::string why =
-            law.calibrated_for ? staleCalibration(as_drift, fixture)
-                               : "it records no calibrated_for (given by hand, or an older file)";
+        std::string why =
+            !law.calibrated_for ? "it records no calibrated_for (given by hand, or an older file)"
+            : law.calibrated_for->method != "sampling"
+                ? "it was not measured by sampling (" +
+                      (law.calibrated_for->method.empty() ? std::string("method not recorded")
+                                                          : law.calibrated_for->method) +
+                      ")"
+                : staleCalibration(as_drift, fixture);
+        const std::string prefix = "its calibrated drift was ";
+        if (why.rfind(prefix, 0) == 0) why = "it was " + why.substr(prefix.size());
         std::fprintf(log,
                      "%s: fixture '%s': its calibrated drift is dropped (the efficiency factors' "
                      "calibrated_for, which it would share, cannot vouch for it): %s\n",

@@ -261,37 +261,35 @@ Scene withEfficiency(Scene scene, const EfficiencyCalibration& calibration) {
   }
   FeederLaw& law = scene.fixtures[static_cast<std::size_t>(calibration.fixture)].law;
   // A calibrated drift kept beside the factors shares their calibrated_for: it stays only if it
-  // was measured for this same feeder, else the new record would vouch for it.
+  // was sampled for this same feeder and parts, else the new record would vouch for it (a
+  // classical drift would also lose its own record, and be redone by sampling).
   if (law.has_calibrated_drift) {
     Scene as_drift = scene;
     as_drift.fixtures[static_cast<std::size_t>(calibration.fixture)].law.drift_model =
         DriftModel::CalibratedDrift;
-    if (!law.calibrated_for || !staleCalibration(as_drift, calibration.fixture).empty()) {
+    if (!law.calibrated_for || law.calibrated_for->method != "sampling" ||
+        !staleCalibration(as_drift, calibration.fixture).empty()) {
       law.has_calibrated_drift = false;
     }
   }
-  // The record now vouches for every family's factor: the others keep their digests where
-  // the old record fits this feeder (apart from the parts), and are marked not measured ("")
-  // where it does not; factors set by default or by hand (no record) count as given.
+  // The new record vouches only for what was measured under it: the other families keep their
+  // digests where the old record holds one for each family and fits this feeder apart from the
+  // parts (a later change of a family then shows as a different digest); otherwise (a first
+  // calibration, a pre-digest record, families added or removed, another feeder) they are
+  // marked not measured (""), and staleCalibration asks for them.
   CalibrationBasis next = calibrationBasis(scene, calibration.fixture, "sampling");
-  const bool had_factors =
-      law.drift_model == DriftModel::LocalSampled && !law.efficiency.empty() && law.calibrated_for;
-  bool feeder_fits = true;
-  if (had_factors) {
+  bool keep = law.drift_model == DriftModel::LocalSampled && law.calibrated_for &&
+              law.efficiency.size() == scene.parts.size() &&
+              law.calibrated_for->part_digests.size() == next.part_digests.size();
+  if (keep) {
     Scene apart_from_parts = scene;
     apart_from_parts.fixtures[static_cast<std::size_t>(calibration.fixture)]
         .law.calibrated_for->part_digests.clear();
-    feeder_fits = staleCalibration(apart_from_parts, calibration.fixture).empty();
+    keep = staleCalibration(apart_from_parts, calibration.fixture).empty();
   }
-  const std::vector<std::string> old =
-      had_factors ? law.calibrated_for->part_digests : std::vector<std::string>{};
   for (std::size_t j = 0; j < next.part_digests.size(); ++j) {
     if (j == static_cast<std::size_t>(calibration.family)) continue;
-    if (!feeder_fits) {
-      next.part_digests[j].clear();
-    } else if (old.size() == next.part_digests.size()) {
-      next.part_digests[j] = old[j];
-    }
+    next.part_digests[j] = keep ? law.calibrated_for->part_digests[j] : std::string();
   }
   law.drift_model = DriftModel::LocalSampled;
   if (law.efficiency.size() != scene.parts.size()) law.efficiency.assign(scene.parts.size(), 1.0);

@@ -171,12 +171,21 @@ std::string staleCalibration(const Scene& scene, int fixture) {
   if (was.track_point && isScrew(v) && !scene.parts.empty()) {
     // The model takes the track at the point's distance from the axis (its vibration there);
     // a point moved round the axis or along it is the same track.
-    const auto radius = [&v](const Vec3& point) {
-      return norm(tangentialPart(point - v.axis_origin, v.axis_direction));
+    // That holds where the translation and gravity lie along the axis (a bowl's screw); with
+    // either tilted the track's place round the axis matters too, and the point is compared.
+    const Vec3 now = 0.5 * (scene.parts[0].spawn_min + scene.parts[0].spawn_max);
+    const auto along_axis = [&v](const Vec3& x) {
+      return norm(cross(x, v.axis_direction)) <= 1e-9 * norm(x);
     };
-    number(feeder, "track radius (m, the first part family's spawn centre from the axis)",
-           radius(*was.track_point),
-           radius(0.5 * (scene.parts[0].spawn_min + scene.parts[0].spawn_max)));
+    if ((v.amplitude == 0 || along_axis(v.direction)) && along_axis(scene.gravity)) {
+      const auto radius = [&v](const Vec3& point) {
+        return norm(tangentialPart(point - v.axis_origin, v.axis_direction));
+      };
+      number(feeder, "track radius (m, the first part family's spawn centre from the axis)",
+             radius(*was.track_point), radius(now));
+    } else {
+      vector("track point (m, the first part family's spawn centre)", *was.track_point, now);
+    }
   }
   if (was.restitution) number(feeder, "restitution", *was.restitution, scene.material.restitution);
   // Each fixture's geometry: the sample run's parts may meet any of them.
@@ -213,8 +222,9 @@ std::string staleCalibration(const Scene& scene, int fixture) {
         const std::string family = "parts[" + std::to_string(k) + "] '" + scene.parts[k].name + "'";
         if (then.empty()) {
           parts += (parts.empty() ? "" : ", ") + family +
-                   " (this record did not measure its factor: it was measured for the feeder as it "
-                   "was before)";
+                   (drift ? " (not recorded)"
+                          : " (its factor is not one this record measured: calibrate every "
+                            "family)");
         } else if (then != now) {
           note(parts,
                family +
@@ -240,10 +250,16 @@ bool uncheckedCalibration(const FeederLaw& law) {
          !lacksCalibration(law) && !law.calibrated_for;
 }
 
-bool partlyCheckedCalibration(const FeederLaw& law) {
-  return law.kind == FeederLaw::Kind::Vibration && law.drift_model != DriftModel::Local &&
-         !lacksCalibration(law) && law.calibrated_for &&
-         law.calibrated_for->method != "classical" && law.calibrated_for->part_digests.empty();
+std::string missingDigests(const FeederLaw& law) {
+  if (law.kind != FeederLaw::Kind::Vibration || law.drift_model == DriftModel::Local ||
+      lacksCalibration(law) || !law.calibrated_for) {
+    return "";
+  }
+  const CalibrationBasis& was = *law.calibrated_for;
+  // A classical calibrated drift depends on neither; efficiency factors are always sampled.
+  if (was.method == "classical" && law.drift_model == DriftModel::CalibratedDrift) return "";
+  const bool parts = was.part_digests.empty(), fixtures = was.fixture_digests.empty();
+  return parts && fixtures ? "part or fixture" : parts ? "part" : fixtures ? "fixture" : "";
 }
 
 }  // namespace rheofeed::scene

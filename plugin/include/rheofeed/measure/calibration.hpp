@@ -121,10 +121,11 @@ EfficiencyCalibration calibrateEfficiency(const Scene& scene, int fixture, int f
 /// `calibration.efficiency` as the factor of `calibration.family` (the other families keep
 /// theirs, 1 when the fixture had none), its calibrated_for set from `scene` as withCalibration
 /// does, with `calibration.family`'s digest; the other families keep the digests of their
-/// factors where the old record fits this feeder apart from the parts, else they are marked not
-/// measured (staleCalibration then asks for them: calibrate every family after a change of the
-/// feeder). A calibrated drift kept beside them is dropped unless its calibrated_for was this
-/// same feeder (one record serves both). Throws std::invalid_argument for a bad index.
+/// factors where the old record holds one per family and fits this feeder apart from the parts,
+/// else they are marked not measured (staleCalibration then asks for them: calibrate every
+/// family, as calibrateScene does). A calibrated drift kept beside them is dropped unless it was
+/// sampled for this same feeder and parts (one record serves both). Throws
+/// std::invalid_argument for a bad index.
 Scene withEfficiency(Scene scene, const EfficiencyCalibration& calibration);
 
 /// How the drift fields are found.

@@ -420,10 +420,11 @@ std::string fixtureDigest(const Fixture& fixture);
 /// not change a steady drift).
 std::string staleCalibration(const Scene& scene, int fixture);
 
-/// True when `law`'s drift model uses a calibration measured by sampling (or by a method not
-/// recorded) whose calibrated_for records no part or fixture digests (a file written before
-/// they were kept): a change of the parts or fixtures since cannot be noticed. Callers say so.
-bool partlyCheckedCalibration(const FeederLaw& law);
+/// Which digests the calibrated_for of the calibration `law`'s drift model uses lacks ("part",
+/// "fixture", "part or fixture"; "" when it has both, needs neither (a classical calibrated
+/// drift), uses no calibration or has no calibrated_for): a record written before they were
+/// kept, whose changes of the parts or fixtures cannot be noticed. Callers say so.
+std::string missingDigests(const FeederLaw& law);
 
 /// True when `law`'s drift model uses a calibration (a calibrated drift, or local_sampled's
 /// efficiency factors) that does not say what it was measured for (no calibrated_for: given by
