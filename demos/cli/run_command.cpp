@@ -282,7 +282,7 @@ int runCommand(const RunArgs& args) {
     }
     for (const Fixture& f : calibrated.fixtures) {  // a calibration that cannot be checked
       if (!any_rheonomic) continue;
-      if (!uncheckedCalibration(f.law) && !!missingDigests(f.law).empty()) continue;
+      if (!uncheckedCalibration(f.law) && missingDigests(f.law).empty()) continue;
       const std::string why = uncheckedCalibration(f.law)
                                   ? uncheckedCalibrationNote(f, args.scene.scene)
                                   : partlyCheckedCalibrationNote(f, args.scene.scene);

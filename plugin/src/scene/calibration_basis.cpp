@@ -2,6 +2,7 @@
 // What a calibration was measured for (CalibrationBasis, scene.hpp), and whether a scene still
 // fits it (staleCalibration): the feeder's vibration, gravity and friction, the direction the
 // drift is measured along, and for a sample run the parts and the fixtures' geometry it ran.
+#include <algorithm>
 #include <charconv>
 #include <cinttypes>
 #include <cmath>
