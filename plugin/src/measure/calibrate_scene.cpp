@@ -144,18 +144,7 @@ CalibrateReport calibrateScene(Scene& scene, const CalibrateOptions& options,
       if (law.has_calibrated_drift && !sampled.fixtures[i].law.has_calibrated_drift) {
         // withEfficiency: one calibrated_for serves both; a drift not known to fit this
         // feeder would pass for one
-        Scene as_drift = scene;
-        as_drift.fixtures[i].law.drift_model = DriftModel::CalibratedDrift;
-        std::string why =
-            !law.calibrated_for ? "it records no calibrated_for (given by hand, or an older file)"
-            : law.calibrated_for->method != "sampling"
-                ? "it was not measured by sampling (" +
-                      (law.calibrated_for->method.empty() ? std::string("method not recorded")
-                                                          : law.calibrated_for->method) +
-                      ")"
-                : staleCalibration(as_drift, fixture);
-        const std::string prefix = "its calibrated drift was ";
-        if (why.rfind(prefix, 0) == 0) why = "it was " + why.substr(prefix.size());
+        const std::string why = driftCannotShareFactorsRecord(scene, fixture);
         std::fprintf(log,
                      "%s: fixture '%s': its calibrated drift is dropped (the efficiency factors' "
                      "calibrated_for, which it would share, cannot vouch for it): %s\n",

@@ -250,6 +250,25 @@ EfficiencyCalibration calibrateEfficiency(const Scene& scene, int fixture, int f
   return c;
 }
 
+std::string driftCannotShareFactorsRecord(const Scene& scene, int fixture) {
+  const FeederLaw& law = scene.fixtures.at(static_cast<std::size_t>(fixture)).law;
+  if (!law.has_calibrated_drift) return "";
+  if (!law.calibrated_for) return "it records no calibrated_for (given by hand, or an older file)";
+  // A classical drift would also lose its own record, and be redone by sampling.
+  if (law.calibrated_for->method != "sampling") {
+    return "it was not measured by sampling (" +
+           (law.calibrated_for->method.empty() ? std::string("method not recorded")
+                                               : law.calibrated_for->method) +
+           ")";
+  }
+  Scene as_drift = scene;
+  as_drift.fixtures[static_cast<std::size_t>(fixture)].law.drift_model =
+      DriftModel::CalibratedDrift;
+  const std::string stale = staleCalibration(as_drift, fixture);
+  const std::string prefix = "its calibrated drift was ";
+  return stale.rfind(prefix, 0) == 0 ? "it was " + stale.substr(prefix.size()) : stale;
+}
+
 Scene withEfficiency(Scene scene, const EfficiencyCalibration& calibration) {
   if (calibration.fixture < 0 || calibration.fixture >= static_cast<int>(scene.fixtures.size())) {
     throw std::invalid_argument("withEfficiency: no fixture " +
@@ -260,17 +279,9 @@ Scene withEfficiency(Scene scene, const EfficiencyCalibration& calibration) {
                                 std::to_string(calibration.family));
   }
   FeederLaw& law = scene.fixtures[static_cast<std::size_t>(calibration.fixture)].law;
-  // A calibrated drift kept beside the factors shares their calibrated_for: it stays only if it
-  // was sampled for this same feeder and parts, else the new record would vouch for it (a
-  // classical drift would also lose its own record, and be redone by sampling).
-  if (law.has_calibrated_drift) {
-    Scene as_drift = scene;
-    as_drift.fixtures[static_cast<std::size_t>(calibration.fixture)].law.drift_model =
-        DriftModel::CalibratedDrift;
-    if (!law.calibrated_for || law.calibrated_for->method != "sampling" ||
-        !staleCalibration(as_drift, calibration.fixture).empty()) {
-      law.has_calibrated_drift = false;
-    }
+  if (law.has_calibrated_drift &&
+      !driftCannotShareFactorsRecord(scene, calibration.fixture).empty()) {
+    law.has_calibrated_drift = false;
   }
   // The new record vouches only for what was measured under it: the other families keep their
   // digests where the old record holds one for each family and fits this feeder apart from the

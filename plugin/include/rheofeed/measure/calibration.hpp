@@ -128,6 +128,13 @@ EfficiencyCalibration calibrateEfficiency(const Scene& scene, int fixture, int f
 /// std::invalid_argument for a bad index.
 Scene withEfficiency(Scene scene, const EfficiencyCalibration& calibration);
 
+/// Why fixture `fixture`'s calibrated drift cannot stay beside the efficiency factors that
+/// withEfficiency records (one calibrated_for serves both, and would vouch for it): "" when it
+/// has none, or was sampled for this same feeder and parts; else "it records no
+/// calibrated_for ...", "it was not measured by sampling (classical)" or "it was measured for
+/// another feeder: ..." (staleCalibration's reason). Throws std::out_of_range for a bad index.
+std::string driftCannotShareFactorsRecord(const Scene& scene, int fixture);
+
 /// How the drift fields are found.
 struct CalibrateOptions {
   /// The classical single-part model (calibrateClassical: milliseconds, a straight-track

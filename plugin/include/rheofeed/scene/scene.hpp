@@ -402,7 +402,7 @@ CalibrationBasis calibrationBasis(const Scene& scene, int fixture, const std::st
 /// (locale-independent), so that a scene read back from its file gives the same digest. A mesh
 /// is hashed as loaded (after assimp's processing and centring): another assimp may change it,
 /// which makes its calibrations stale, said.
-std::string partDigest(const PartSpec& parts);
+std::string partDigest(const PartSpec& family);
 /// A digest, as partDigest, of a fixture's geoms: shapes, sizes, meshes and poses at rest (not
 /// its name or law).
 std::string fixtureDigest(const Fixture& fixture);
@@ -412,12 +412,11 @@ std::string fixtureDigest(const Fixture& fixture);
 /// CalibrationBasis that differ from the fixture's vibration, the scene's gravity, mu,
 /// conveying direction (straight tracks), track point (classical screws), restitution, part
 /// families and fixtures' geometry (sampling calibrations) now, each with both values ("its
-/// calibrated drift was measured for another feeder: amplitude (m) 0.0005 when calibrated, 0.0008
-/// now";
-/// "... measured with other parts: parts[0] 'plates' (the digest of ...) 3f2a... when
-/// calibrated, 91c0... now"); "" when it fits, when the law uses no calibration, or when its basis
-/// is not known. Fields the basis does not record are not compared. Phase is not compared (it does
-/// not change a steady drift).
+/// calibrated drift was measured for another feeder: amplitude (m) 0.0005 when calibrated,
+/// 0.0008 now"; "... measured with other parts: parts[0] 'plates' (the digest of ...) 3f2a...
+/// when calibrated, 91c0... now"); "" when it fits, when the law uses no calibration, or when
+/// its basis is not known. Fields the basis does not record are not compared. Phase is not
+/// compared (it does not change a steady drift).
 std::string staleCalibration(const Scene& scene, int fixture);
 
 /// Which digests the calibrated_for of the calibration `law`'s drift model uses lacks ("part",
